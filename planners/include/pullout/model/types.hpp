@@ -1,0 +1,199 @@
+// The pullout data model: the values exchanged between a vehicle and the planner.
+//
+// Plain value types with no dependencies beyond the standard library, so that the client library
+// can expose them in its public headers. They mirror the DDS topics of idl/pullout.idl; conversion
+// to and from the generated DDS types happens in exactly one place (idl/src/convert.cpp).
+//
+// Frames and units: every pose and point is in the map frame, x/y in metres, yaw in radians
+// (counter-clockwise from +x). Velocities in m/s, accelerations in m/s^2, times in seconds unless a
+// name says otherwise.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pullout {
+
+struct Point2 {
+  double x{0.0};  // [m]
+  double y{0.0};  // [m]
+};
+
+// Pose of a body B in the map frame M (X_MB). yaw [rad] counter-clockwise from the map +x axis.
+struct Pose2 {
+  double x{0.0};    // [m]
+  double y{0.0};    // [m]
+  double yaw{0.0};  // [rad]
+};
+
+enum class LaneSubtype : std::uint8_t { kRoad = 0, kRoadShoulder = 1 };
+
+// A lane given inline in a request: two bounds (ordered in the driving direction) and an optional
+// centerline. When the centerline is empty the planner derives it from the bounds.
+struct Lane {
+  std::int64_t id{0};
+  LaneSubtype subtype{LaneSubtype::kRoad};
+  std::vector<Point2> left_bound;
+  std::vector<Point2> right_bound;
+  std::vector<Point2> centerline;  // optional
+  double speed_limit_mps{13.89};   // [m/s]
+};
+
+enum class ObjectClass : std::uint8_t {
+  kUnknown = 0,
+  kCar = 1,
+  kTruck = 2,
+  kBus = 3,
+  kTrailer = 4,
+  kMotorcycle = 5,
+  kBicycle = 6,
+  kPedestrian = 7,
+};
+
+// A predicted path of an object: poses at t0, t0 + time_step, ...
+struct PredictedPath {
+  std::vector<Pose2> poses;
+  double time_step_s{1.0};  // [s]
+  double confidence{1.0};   // [0, 1]
+};
+
+// An object around the vehicle. Its footprint is a box length x width centred on `pose`, unless
+// `polygon` is given (a convex polygon in the object frame, counter-clockwise).
+struct Object {
+  std::int64_t id{0};
+  ObjectClass object_class{ObjectClass::kUnknown};
+  Pose2 pose;
+  double length_m{4.5};
+  double width_m{1.9};
+  std::vector<Point2> polygon;  // optional, object frame
+  double velocity_mps{0.0};     // longitudinal speed along the object's heading [m/s]
+  std::vector<PredictedPath> predicted_paths;
+};
+
+// An occupancy grid in the ROS convention: row-major from `origin`, cells 0 (free) .. 100
+// (occupied), -1 unknown.
+struct OccupancyGrid {
+  double resolution_m{0.2};
+  Pose2 origin;
+  std::uint32_t width{0};
+  std::uint32_t height{0};
+  std::vector<std::int8_t> data;
+};
+
+enum class PlannerType : std::uint8_t {
+  kNone = 0,
+  kShift = 1,
+  kGeometric = 2,
+  kClothoid = 3,
+  kStop = 4,
+  kFreespace = 5,
+};
+
+enum class SearchPolicy : std::uint8_t { kPlannerPriority = 0, kDistancePriority = 1 };
+
+// Per-request overrides of the service's planner configuration. Empty / unset means "use the
+// service's configuration".
+struct PlannerOverrides {
+  std::vector<PlannerType> search_priority;
+  std::optional<SearchPolicy> search_policy;
+};
+
+struct PullOutRequest {
+  std::string vehicle_id;
+  std::uint64_t request_id{0};
+  std::int64_t stamp_ns{0};  // [ns] since the epoch of the sender's clock
+  Pose2 ego_pose;
+  double ego_velocity_mps{0.0};
+  Pose2 goal_pose;
+  std::vector<Lane> lanes;                      // inline lanes, or ...
+  std::vector<std::int64_t> route_lanelet_ids;  // ... route lanelets on the service's map
+  std::vector<Object> objects;
+  std::optional<OccupancyGrid> occupancy_grid;
+  PlannerOverrides overrides;
+  double deadline_ms{0.0};  // [ms] planning budget; 0 = the service's default
+};
+
+struct PathPoint {
+  Pose2 pose;
+  double longitudinal_velocity_mps{0.0};  // signed: negative when reversing
+  std::vector<std::int64_t> lane_ids;
+};
+
+struct PathWithLaneId {
+  std::vector<PathPoint> points;
+};
+
+// The velocity and acceleration the vehicle should reach at the end of one partial path.
+struct TerminalVelocityAccel {
+  double velocity_mps{0.0};
+  double accel_mps2{0.0};
+};
+
+enum class TurnSignal : std::uint8_t { kNone = 0, kLeft = 1, kRight = 2 };
+
+// One row of the planner evaluation table: one attempt of one planner at one margin from one start
+// candidate, and what came of it ("success", "collision", "lane departure", ...).
+struct PlannerAttempt {
+  PlannerType planner{PlannerType::kNone};
+  double margin_m{0.0};
+  double backward_distance_m{0.0};
+  std::string outcome;
+};
+
+struct PullOutPath {
+  std::string vehicle_id;
+  std::uint64_t request_id{0};
+  std::int64_t stamp_ns{0};
+  bool found{false};
+  PlannerType planner_type{PlannerType::kNone};
+  std::vector<PathWithLaneId> partial_paths;
+  std::vector<TerminalVelocityAccel> pairs_terminal_velocity_and_accel;
+  Pose2 start_pose;
+  Pose2 end_pose;
+  double shift_length_m{0.0};  // signed lateral offset removed by the pull-out, left positive
+  TurnSignal turn_signal{TurnSignal::kNone};
+  std::vector<std::string> reasons;  // why nothing was found (found == false)
+};
+
+enum class ExecutionState : std::uint8_t {
+  kIdle = 0,       // no request yet
+  kPlanning = 1,   // request accepted, search running
+  kRejected = 2,   // request invalid: see `error`
+  kNoPath = 3,     // no path: a stop path was published, see `stop_reason`
+  kExecuting = 4,  // a path was found and is being followed (current_path_idx)
+  kCompleted = 5,  // the vehicle passed the end pose of the last segment
+};
+
+struct PullOutStatus {
+  std::string vehicle_id;
+  std::uint64_t request_id{0};
+  std::int64_t stamp_ns{0};
+  ExecutionState state{ExecutionState::kIdle};
+  std::uint32_t current_path_idx{0};
+  std::uint32_t segment_count{0};
+  PlannerType planner_type{PlannerType::kNone};
+  std::vector<PlannerAttempt> evaluation_table;
+  std::string stop_reason;
+  std::string error;  // kRejected: "<field>: <problem>" lines
+  double planning_time_ms{0.0};
+};
+
+// A problem with a request: the field (e.g. "lanes[2].left_bound[5].x", "ego_pose.orientation")
+// and what is wrong with it.
+struct RequestIssue {
+  std::string field;
+  std::string problem;
+};
+
+struct ExecutionProgress {
+  std::string vehicle_id;
+  std::uint64_t request_id{0};
+  std::int64_t stamp_ns{0};  // [ns] time of the odometry sample
+  Pose2 pose;
+  double velocity_mps{0.0};
+  bool approved{true};
+};
+
+}  // namespace pullout

@@ -1,0 +1,90 @@
+// Parameters of the start planner. Names follow Autoware's start_planner.param.yaml where the
+// concept is the same (see config/pullout.yaml), defaults are the same as that file's.
+// validate_parameters() reports every out-of-range value; the core assumes validated parameters.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "pullout/model/types.hpp"
+#include "pullout/vehicle/vehicle_info.hpp"
+
+namespace pullout {
+
+// Which object classes the static collision check of path generation considers.
+struct ObjectTypesToCheck {
+  bool check_car{true};
+  bool check_truck{true};
+  bool check_bus{true};
+  bool check_trailer{true};
+  bool check_bicycle{true};
+  bool check_motorcycle{true};
+  bool check_pedestrian{true};
+  bool check_unknown{true};
+
+  bool includes(ObjectClass c) const;
+};
+
+struct StartPlannerParameters {
+  // --- execution ---
+  double th_arrived_distance{1.0};   // [m] segment end reached within this distance
+  double th_stopped_velocity{0.01};  // [m/s] |v| below this counts as stopped
+  double th_stopped_time{1.0};       // [s] stopped for this long before a segment counts as done
+
+  // --- search ---
+  std::vector<double> collision_check_margins{2.0, 1.0, 0.5, 0.1};  // [m] tried in order
+  std::vector<PlannerType> search_priority{PlannerType::kShift};      // planners, in order
+  SearchPolicy search_policy{SearchPolicy::kPlannerPriority};
+
+  // --- objects considered by path generation ---
+  double th_moving_object_velocity{1.0};  // [m/s] objects slower than this are static obstacles
+  ObjectTypesToCheck object_types_to_check_for_path_generation;
+
+  // --- reference path ---
+  double center_line_path_interval{1.0};  // [m] resampling interval of the road centerline
+  double forward_path_length{300.0};      // [m] path length after the start when the goal is farther
+
+  // --- lane departure ---
+  bool check_shift_path_lane_departure{true};
+  bool allow_check_shift_path_lane_departure_override{false};
+  double lane_departure_check_expansion_margin{0.0};  // [m] footprint inflation
+
+  // --- shift pull-out ---
+  double shift_collision_check_distance_from_end{-10.0};  // [m] collision section end rel. to end pose
+  double minimum_shift_pull_out_distance{0.0};            // [m]
+  double lateral_jerk{0.5};                               // [m/s^3]
+  int lateral_acceleration_sampling_num{3};               // >= 1
+  double minimum_lateral_acc{0.15};                       // [m/s^2]
+  double maximum_lateral_acc{0.5};                        // [m/s^2]
+  double maximum_curvature{0.07};                         // [1/m]
+  double end_pose_curvature_threshold{0.1};               // [1/m]
+  double maximum_longitudinal_acc{1.0};                   // [m/s^2] cap of the pull-out acceleration
+};
+
+// One problem with a parameter: the parameter's name and what is wrong.
+struct ParameterIssue {
+  std::string name;
+  std::string problem;
+};
+
+// Every out-of-range or inconsistent value, in declaration order. Empty when valid.
+std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p);
+// Same for the vehicle (names are the VehicleInfo field names without the unit suffix).
+std::vector<ParameterIssue> validate_vehicle(const VehicleInfo& v);
+
+// Limits on the size of a request, so that one vehicle cannot make the service allocate or compute
+// without bound. Defaults are generous for real use.
+struct RequestLimits {
+  std::size_t max_lanes{256};
+  std::size_t max_points_per_line{10000};  // points in one bound or centerline
+  std::size_t max_objects{512};
+  std::size_t max_polygon_points{64};          // points of one object polygon
+  std::size_t max_predicted_paths{16};         // per object
+  std::size_t max_predicted_path_points{200};  // per predicted path
+  std::size_t max_route_lanelets{1000};
+  std::size_t max_grid_cells{16u * 1024u * 1024u};
+  double max_deadline_ms{10000.0};
+};
+
+}  // namespace pullout

@@ -1,0 +1,65 @@
+// Loading and validating config/pullout.yaml.
+//
+// The file has four sections: `vehicle` (VehicleInfo fields without the unit suffix, e.g.
+// wheel_base), `start_planner` (StartPlannerParameters, Autoware's names), `service` (workers,
+// default deadline, request limits, log level) and `dds` (domain id, XML profiles file, participant
+// profile). Every key is optional (the struct defaults apply) but an unknown key, a value of the
+// wrong type or an out-of-range value is an error. load_config() reports every problem at once.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pullout/pipeline/parameters.hpp"
+#include "pullout/vehicle/vehicle_info.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace pullout {
+
+struct DdsConfig {
+  int domain_id{0};                // 0..232
+  std::string profiles_file;       // Fast DDS XML profiles; relative paths are relative to the config file
+  std::string participant_profile{"pullout_participant"};
+};
+
+struct ServiceConfig {
+  int worker_threads{2};            // planning threads, >= 1
+  double default_deadline_ms{200.0};  // planning budget when a request gives none
+  RequestLimits limits;
+  std::string log_level{"info"};    // trace, debug, info, warn, error, critical, off
+};
+
+struct Config {
+  VehicleInfo vehicle;
+  StartPlannerParameters start_planner;
+  ServiceConfig service;
+  DdsConfig dds;
+};
+
+// Thrown by load_config / load_scenario with one line per problem: "<file>: <key path>: <problem>".
+class ConfigError : public std::runtime_error {
+ public:
+  ConfigError(const std::string& file, std::vector<std::string> problems);
+  const std::vector<std::string>& problems() const { return problems_; }
+
+ private:
+  std::vector<std::string> problems_;
+};
+
+// Loads and validates a config file. Throws ConfigError (every problem) or if the file cannot be
+// read or parsed.
+Config load_config(const std::string& path);
+
+// Applies a YAML mapping of start_planner parameters (Autoware names) onto `params`, appending one
+// "<prefix>.<key>: <problem>" line per problem. Used by load_config and by scenario files'
+// `planner:` section.
+void apply_start_planner_parameters(const YAML::Node& node, const std::string& prefix,
+                                    StartPlannerParameters& params, std::vector<std::string>& problems);
+void apply_vehicle_info(const YAML::Node& node, const std::string& prefix, VehicleInfo& vehicle,
+                        std::vector<std::string>& problems);
+
+}  // namespace pullout
