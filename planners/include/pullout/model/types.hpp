@@ -152,7 +152,7 @@ struct PullOutPath {
   std::vector<TerminalVelocityAccel> pairs_terminal_velocity_and_accel;
   Pose2 start_pose;
   Pose2 end_pose;
-  double shift_length_m{0.0};  // signed lateral offset removed by the pull-out, left positive
+  double shift_length_m{0.0};  // lateral offset of the start from the road centerline, left positive [m]
   TurnSignal turn_signal{TurnSignal::kNone};
   std::vector<std::string> reasons;  // why nothing was found (found == false)
 };

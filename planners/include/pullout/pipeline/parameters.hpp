@@ -62,6 +62,9 @@ struct StartPlannerParameters {
   double maximum_longitudinal_acc{1.0};                   // [m/s^2] cap of the pull-out acceleration
 };
 
+// Whether this version of the core implements a planner (search_priority may only name these).
+bool planner_available(PlannerType type);
+
 // One problem with a parameter: the parameter's name and what is wrong.
 struct ParameterIssue {
   std::string name;

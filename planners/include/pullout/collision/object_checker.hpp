@@ -1,0 +1,56 @@
+// Static-object clearance of the vehicle footprint, with FCL (exact convex distance, GJK).
+//
+// The vehicle is a box (its Footprint) swept along poses; each obstacle is a convex prism built
+// from its polygon. "Collision at margin m" means that the distance between the vehicle footprint
+// and some obstacle is below m (touching or overlapping counts as distance 0). A cheap
+// bounding-circle test skips the exact query for obstacles that are clearly far.
+//
+// Thread safety: const methods may be called concurrently (each call uses its own FCL objects).
+#pragma once
+
+#include <limits>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "pullout/collision/footprint.hpp"
+
+namespace pullout {
+
+struct Obstacle {
+  std::int64_t id{0};
+  Polygon polygon;  // convex, map frame; non-convex input is replaced by its convex hull
+};
+
+class ObjectChecker {
+ public:
+  ObjectChecker(const Footprint& vehicle, std::vector<Obstacle> obstacles);
+  ~ObjectChecker();
+  ObjectChecker(ObjectChecker&&) noexcept;
+  ObjectChecker& operator=(ObjectChecker&&) noexcept;
+
+  struct Clearance {
+    double distance{std::numeric_limits<double>::infinity()};  // [m], 0 when overlapping
+    std::int64_t obstacle_id{0};                                 // the nearest one
+  };
+  // Smallest distance from the footprint at X_MV = `pose` to any obstacle, considering only
+  // obstacles closer than `horizon` (others report +inf).
+  Clearance clearance(const Pose2& pose, double horizon = std::numeric_limits<double>::infinity()) const;
+
+  // First pose whose clearance is below `margin`, with the obstacle it hits; nullopt if none.
+  struct Hit {
+    std::size_t pose_index{0};
+    std::int64_t obstacle_id{0};
+    double distance{0.0};
+  };
+  std::optional<Hit> first_hit(const std::vector<Pose2>& poses, double margin) const;
+
+  std::size_t obstacle_count() const;
+  const Footprint& footprint() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pullout

@@ -1,0 +1,82 @@
+// The lanes of one request, prepared for planning: polygons, centerlines, topology, a spatial
+// index, and the lane-departure test of a footprint against the union of all lanes.
+//
+// Topology: lane B succeeds lane A when B's bounds start where A's bounds end (both end points
+// within 0.1 m). Lanes are expected to be valid (see StartPlanner::validate): at least two points
+// per bound and a polygon with non-zero area.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "pullout/geometry/polygon.hpp"
+#include "pullout/geometry/polyline.hpp"
+#include "pullout/model/types.hpp"
+
+namespace pullout {
+
+struct LaneGeometry {
+  std::int64_t id{0};
+  LaneSubtype subtype{LaneSubtype::kRoad};
+  Polyline left;
+  Polyline right;
+  Polyline centerline;  // given, or the midpoints of the bounds resampled by arc length
+  Polygon polygon;      // left bound forward, right bound backward
+  Aabb box;
+  double speed_limit_mps{0.0};
+  std::vector<std::size_t> successors;
+  std::vector<std::size_t> predecessors;
+};
+
+// A sequence of connected lanes and the centerline through them, with the arc-length range each
+// lane covers on it.
+struct LaneChain {
+  std::vector<std::size_t> lanes;
+  Polyline centerline;
+  std::vector<double> lane_end_s;  // arc length at which lanes[i] ends on `centerline`
+
+  // Index into `lanes` of the lane covering arc length s (clamped).
+  std::size_t lane_at(double s) const;
+};
+
+class LaneWorld {
+ public:
+  explicit LaneWorld(const std::vector<Lane>& lanes);
+
+  const std::vector<LaneGeometry>& lanes() const { return lanes_; }
+  std::optional<std::size_t> find(std::int64_t id) const;
+
+  // Lanes whose polygon contains p.
+  std::vector<std::size_t> lanes_containing(const Vec2& p) const;
+  bool contains(const Vec2& p) const;
+
+  // The lane of `subtype` whose centerline is nearest to p (lateral distance), if any.
+  std::optional<std::size_t> nearest_lane(const Vec2& p, LaneSubtype subtype) const;
+
+  // The chain of lanes through `seed`, following predecessors back and successors forward (the
+  // first one when there are several), without cycles.
+  LaneChain chain_through(std::size_t seed) const;
+
+  // True when the footprint (corners counter-clockwise) lies inside the union of the lanes: every
+  // corner is inside some lane and no footprint edge crosses the outer boundary of the union.
+  bool footprint_inside(const std::array<Vec2, 4>& corners) const;
+
+ private:
+  void build_topology();
+  void build_index();
+  std::int64_t cell_key(long ix, long iy) const { return (static_cast<std::int64_t>(ix) << 32) ^ (iy & 0xffffffff); }
+  template <typename F>
+  void for_cells(const Aabb& box, F&& f) const;
+
+  std::vector<LaneGeometry> lanes_;
+  // Pieces of lane edges that are not shared with a neighbouring lane: the outline of the union.
+  std::vector<std::pair<Vec2, Vec2>> outer_edges_;
+  double cell_size_{4.0};
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> lane_cells_;
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> edge_cells_;
+};
+
+}  // namespace pullout

@@ -1,0 +1,226 @@
+#include "pullout/lanes/lane_world.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+namespace pullout {
+
+namespace {
+
+constexpr double kConnectTolerance = 0.1;    // [m] bound end points closer than this connect lanes
+constexpr double kEdgePieceLength = 0.5;     // [m] lane edges are split into pieces this long
+constexpr double kSharedEdgeProbe = 0.05;    // [m] probe distance outside an edge piece
+constexpr double kCenterlineStep = 0.5;      // [m] sampling of derived centerlines
+
+std::vector<Vec2> to_vecs(const std::vector<Point2>& pts) {
+  std::vector<Vec2> out;
+  out.reserve(pts.size());
+  for (const Point2& p : pts) out.push_back(to_vec(p));
+  return out;
+}
+
+// Midline of two bounds, matched by normalised arc length.
+Polyline derive_centerline(const Polyline& left, const Polyline& right) {
+  const double len = std::max(left.length(), right.length());
+  const auto n = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(len / kCenterlineStep)) + 1);
+  std::vector<Vec2> pts;
+  pts.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / static_cast<double>(n - 1);
+    pts.push_back(0.5 * (left.point_at(t * left.length()) + right.point_at(t * right.length())));
+  }
+  return Polyline(pts);
+}
+
+}  // namespace
+
+std::size_t LaneChain::lane_at(double s) const {
+  const auto it = std::lower_bound(lane_end_s.begin(), lane_end_s.end(), s);
+  if (it == lane_end_s.end()) return lane_end_s.empty() ? 0 : lane_end_s.size() - 1;
+  return static_cast<std::size_t>(std::distance(lane_end_s.begin(), it));
+}
+
+LaneWorld::LaneWorld(const std::vector<Lane>& lanes) {
+  lanes_.reserve(lanes.size());
+  for (const Lane& in : lanes) {
+    LaneGeometry g;
+    g.id = in.id;
+    g.subtype = in.subtype;
+    g.left = Polyline(to_vecs(in.left_bound));
+    g.right = Polyline(to_vecs(in.right_bound));
+    g.centerline = in.centerline.size() >= 2 ? Polyline(to_vecs(in.centerline)) : derive_centerline(g.left, g.right);
+    g.polygon = g.left.points();
+    g.polygon.insert(g.polygon.end(), g.right.points().rbegin(), g.right.points().rend());
+    g.box = bounding_box(g.polygon);
+    g.speed_limit_mps = in.speed_limit_mps;
+    lanes_.push_back(std::move(g));
+  }
+  build_topology();
+  build_index();
+}
+
+std::optional<std::size_t> LaneWorld::find(std::int64_t id) const {
+  for (std::size_t i = 0; i < lanes_.size(); ++i) {
+    if (lanes_[i].id == id) return i;
+  }
+  return std::nullopt;
+}
+
+void LaneWorld::build_topology() {
+  for (std::size_t a = 0; a < lanes_.size(); ++a) {
+    for (std::size_t b = 0; b < lanes_.size(); ++b) {
+      if (a == b) continue;
+      const LaneGeometry& la = lanes_[a];
+      const LaneGeometry& lb = lanes_[b];
+      if ((la.left.points().back() - lb.left.points().front()).norm() < kConnectTolerance &&
+          (la.right.points().back() - lb.right.points().front()).norm() < kConnectTolerance) {
+        lanes_[a].successors.push_back(b);
+        lanes_[b].predecessors.push_back(a);
+      }
+    }
+  }
+}
+
+template <typename F>
+void LaneWorld::for_cells(const Aabb& box, F&& f) const {
+  const long x0 = static_cast<long>(std::floor(box.min.x() / cell_size_));
+  const long x1 = static_cast<long>(std::floor(box.max.x() / cell_size_));
+  const long y0 = static_cast<long>(std::floor(box.min.y() / cell_size_));
+  const long y1 = static_cast<long>(std::floor(box.max.y() / cell_size_));
+  for (long ix = x0; ix <= x1; ++ix) {
+    for (long iy = y0; iy <= y1; ++iy) f(cell_key(ix, iy));
+  }
+}
+
+void LaneWorld::build_index() {
+  for (std::size_t i = 0; i < lanes_.size(); ++i) {
+    for_cells(lanes_[i].box, [&](std::int64_t key) { lane_cells_[key].push_back(static_cast<std::uint32_t>(i)); });
+  }
+  // An edge piece belongs to the outline of the union unless the point just outside it lies in
+  // another lane (a shared bound, or the joint between consecutive lanes). Pieces are short so
+  // that bounds sampled differently on the two sides are still recognised as shared.
+  for (std::size_t i = 0; i < lanes_.size(); ++i) {
+    const Polygon& poly = lanes_[i].polygon;
+    const double orientation = signed_area(poly) >= 0.0 ? 1.0 : -1.0;
+    const std::size_t n = poly.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const Vec2 a = poly[k];
+      const Vec2 b = poly[(k + 1) % n];
+      const double len = (b - a).norm();
+      if (len < 1e-9) continue;
+      const Vec2 dir = (b - a) / len;
+      // For a counter-clockwise polygon the outside is on the right of each edge.
+      const Vec2 outward = -orientation * left_normal(dir);
+      const auto pieces = static_cast<std::size_t>(std::ceil(len / kEdgePieceLength));
+      for (std::size_t p = 0; p < pieces; ++p) {
+        const Vec2 pa = a + dir * (len * static_cast<double>(p) / static_cast<double>(pieces));
+        const Vec2 pb = a + dir * (len * static_cast<double>(p + 1) / static_cast<double>(pieces));
+        const Vec2 probe = 0.5 * (pa + pb) + kSharedEdgeProbe * outward;
+        bool shared = false;
+        for (std::size_t j : lanes_containing(probe)) {
+          if (j != i) {
+            shared = true;
+            break;
+          }
+        }
+        if (!shared) outer_edges_.emplace_back(pa, pb);
+      }
+    }
+  }
+  for (std::size_t e = 0; e < outer_edges_.size(); ++e) {
+    Aabb box;
+    box.extend(outer_edges_[e].first);
+    box.extend(outer_edges_[e].second);
+    for_cells(box, [&](std::int64_t key) { edge_cells_[key].push_back(static_cast<std::uint32_t>(e)); });
+  }
+}
+
+std::vector<std::size_t> LaneWorld::lanes_containing(const Vec2& p) const {
+  std::vector<std::size_t> out;
+  const auto it = lane_cells_.find(cell_key(static_cast<long>(std::floor(p.x() / cell_size_)),
+                                            static_cast<long>(std::floor(p.y() / cell_size_))));
+  if (it == lane_cells_.end()) return out;
+  for (std::uint32_t i : it->second) {
+    if (lanes_[i].box.contains(p) && point_in_polygon(lanes_[i].polygon, p)) out.push_back(i);
+  }
+  return out;
+}
+
+bool LaneWorld::contains(const Vec2& p) const {
+  const auto it = lane_cells_.find(cell_key(static_cast<long>(std::floor(p.x() / cell_size_)),
+                                            static_cast<long>(std::floor(p.y() / cell_size_))));
+  if (it == lane_cells_.end()) return false;
+  for (std::uint32_t i : it->second) {
+    if (lanes_[i].box.contains(p) && point_in_polygon(lanes_[i].polygon, p)) return true;
+  }
+  return false;
+}
+
+std::optional<std::size_t> LaneWorld::nearest_lane(const Vec2& p, LaneSubtype subtype) const {
+  std::optional<std::size_t> best;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < lanes_.size(); ++i) {
+    if (lanes_[i].subtype != subtype || lanes_[i].centerline.size() < 2) continue;
+    const double d = lanes_[i].centerline.project(p).distance;
+    if (d < best_d) {
+      best_d = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
+LaneChain LaneWorld::chain_through(std::size_t seed) const {
+  std::vector<std::size_t> order{seed};
+  std::unordered_set<std::size_t> seen{seed};
+  for (std::size_t cur = seed; !lanes_[cur].predecessors.empty();) {
+    const std::size_t prev = lanes_[cur].predecessors.front();
+    if (!seen.insert(prev).second) break;
+    order.insert(order.begin(), prev);
+    cur = prev;
+  }
+  for (std::size_t cur = seed; !lanes_[cur].successors.empty();) {
+    const std::size_t next = lanes_[cur].successors.front();
+    if (!seen.insert(next).second) break;
+    order.push_back(next);
+    cur = next;
+  }
+  LaneChain chain;
+  chain.lanes = order;
+  std::vector<Vec2> pts;
+  for (std::size_t idx : order) {
+    const auto& c = lanes_[idx].centerline.points();
+    // Consecutive centerlines share their joint point; Polyline drops the duplicate.
+    pts.insert(pts.end(), c.begin(), c.end());
+    chain.centerline = Polyline(pts);
+    chain.lane_end_s.push_back(chain.centerline.length());
+  }
+  return chain;
+}
+
+bool LaneWorld::footprint_inside(const std::array<Vec2, 4>& corners) const {
+  for (const Vec2& c : corners) {
+    if (!contains(c)) return false;
+  }
+  Aabb box;
+  for (const Vec2& c : corners) box.extend(c);
+  bool crosses = false;
+  std::unordered_set<std::uint32_t> tested;
+  for_cells(box, [&](std::int64_t key) {
+    if (crosses) return;
+    const auto it = edge_cells_.find(key);
+    if (it == edge_cells_.end()) return;
+    for (std::uint32_t e : it->second) {
+      if (!tested.insert(e).second) continue;
+      const auto& [a, b] = outer_edges_[e];
+      for (std::size_t k = 0; k < 4 && !crosses; ++k) {
+        crosses = segments_intersect(corners[k], corners[(k + 1) % 4], a, b);
+      }
+      if (crosses) return;
+    }
+  });
+  return !crosses;
+}
+
+}  // namespace pullout

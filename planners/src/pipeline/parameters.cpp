@@ -1,0 +1,175 @@
+// Range checks of the planner and vehicle parameters (see parameters.hpp).
+//
+// The bounds are what the algorithms need to be well defined (positive intervals and limits, at
+// least one sample) plus generous upper bounds where a typo would make the search explode in time
+// or memory (a 1 mm centerline interval, a million acceleration samples).
+#include "pullout/pipeline/parameters.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "pullout/model/names.hpp"
+
+namespace pullout {
+namespace {
+
+bool is_search_planner(PlannerType p) {
+  return p == PlannerType::kShift || p == PlannerType::kGeometric || p == PlannerType::kClothoid ||
+         p == PlannerType::kFreespace;
+}
+
+// "shift, geometric": the planners this version implements (planner_available), for messages.
+std::string available_planner_names() {
+  std::string names;
+  for (const PlannerType p : {PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid,
+                              PlannerType::kFreespace}) {
+    if (!planner_available(p)) continue;
+    if (!names.empty()) names += ", ";
+    names += to_string(p);
+  }
+  return names;
+}
+
+std::string text(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+class Checker {
+ public:
+  explicit Checker(std::vector<ParameterIssue>& issues) : issues_(issues) {}
+
+  void fail(const std::string& name, const std::string& problem) { issues_.push_back({name, problem}); }
+
+  // Each returns false (after recording the issue) when the value is out of range.
+  bool finite(const std::string& name, double v) {
+    if (std::isfinite(v)) return true;
+    fail(name, "must be a finite number, got " + text(v));
+    return false;
+  }
+  void positive(const std::string& name, double v) {
+    if (finite(name, v) && !(v > 0.0)) fail(name, "must be > 0, got " + text(v));
+  }
+  void non_negative(const std::string& name, double v) {
+    if (finite(name, v) && v < 0.0) fail(name, "must be >= 0, got " + text(v));
+  }
+  void in_range(const std::string& name, double v, double lo, double hi) {
+    if (finite(name, v) && (v < lo || v > hi)) {
+      fail(name, "must be in [" + text(lo) + ", " + text(hi) + "], got " + text(v));
+    }
+  }
+
+ private:
+  std::vector<ParameterIssue>& issues_;
+};
+
+}  // namespace
+
+bool ObjectTypesToCheck::includes(ObjectClass c) const {
+  switch (c) {
+    case ObjectClass::kCar:
+      return check_car;
+    case ObjectClass::kTruck:
+      return check_truck;
+    case ObjectClass::kBus:
+      return check_bus;
+    case ObjectClass::kTrailer:
+      return check_trailer;
+    case ObjectClass::kMotorcycle:
+      return check_motorcycle;
+    case ObjectClass::kBicycle:
+      return check_bicycle;
+    case ObjectClass::kPedestrian:
+      return check_pedestrian;
+    case ObjectClass::kUnknown:
+      return check_unknown;
+  }
+  // An out-of-range class value is treated like an unknown object.
+  return check_unknown;
+}
+
+std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p) {
+  std::vector<ParameterIssue> issues;
+  Checker c(issues);
+
+  c.positive("th_arrived_distance", p.th_arrived_distance);
+  c.positive("th_stopped_velocity", p.th_stopped_velocity);
+  c.non_negative("th_stopped_time", p.th_stopped_time);
+
+  constexpr std::size_t kMaxMargins = 16;
+  if (p.collision_check_margins.empty()) {
+    c.fail("collision_check_margins", "must list at least one margin");
+  } else if (p.collision_check_margins.size() > kMaxMargins) {
+    c.fail("collision_check_margins", "at most " + std::to_string(kMaxMargins) + " margins, got " +
+                                          std::to_string(p.collision_check_margins.size()));
+  }
+  for (std::size_t i = 0; i < p.collision_check_margins.size(); ++i) {
+    c.in_range("collision_check_margins[" + std::to_string(i) + "]", p.collision_check_margins[i], 0.0, 10.0);
+  }
+
+  if (p.search_priority.empty()) c.fail("search_priority", "must list at least one planner");
+  for (std::size_t i = 0; i < p.search_priority.size(); ++i) {
+    const std::string name = "search_priority[" + std::to_string(i) + "]";
+    const PlannerType planner = p.search_priority[i];
+    if (!is_search_planner(planner)) {
+      c.fail(name, std::string("'") + to_string(planner) + "' is not a planner that can be searched");
+    } else if (!planner_available(planner)) {
+      c.fail(name, std::string("planner '") + to_string(planner) +
+                       "' is not available in this version (available: " + available_planner_names() + ")");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (p.search_priority[j] == planner) {
+        c.fail(name, std::string("planner '") + to_string(planner) + "' is listed twice");
+        break;
+      }
+    }
+  }
+  if (p.search_policy != SearchPolicy::kPlannerPriority && p.search_policy != SearchPolicy::kDistancePriority) {
+    c.fail("search_policy", "must be planner_priority or distance_priority");
+  }
+
+  c.non_negative("th_moving_object_velocity", p.th_moving_object_velocity);
+
+  c.in_range("center_line_path_interval", p.center_line_path_interval, 0.05, 10.0);
+  c.in_range("forward_path_length", p.forward_path_length, 1.0, 10000.0);
+
+  c.in_range("lane_departure_check_expansion_margin", p.lane_departure_check_expansion_margin, 0.0, 5.0);
+
+  c.finite("shift_collision_check_distance_from_end", p.shift_collision_check_distance_from_end);
+  c.non_negative("minimum_shift_pull_out_distance", p.minimum_shift_pull_out_distance);
+  c.positive("lateral_jerk", p.lateral_jerk);
+  constexpr int kMaxAccelerationSamples = 100;
+  if (p.lateral_acceleration_sampling_num < 1 || p.lateral_acceleration_sampling_num > kMaxAccelerationSamples) {
+    c.fail("lateral_acceleration_sampling_num", "must be in [1, " + std::to_string(kMaxAccelerationSamples) +
+                                                    "], got " + std::to_string(p.lateral_acceleration_sampling_num));
+  }
+  c.positive("minimum_lateral_acc", p.minimum_lateral_acc);
+  c.positive("maximum_lateral_acc", p.maximum_lateral_acc);
+  if (std::isfinite(p.minimum_lateral_acc) && std::isfinite(p.maximum_lateral_acc) &&
+      p.minimum_lateral_acc > p.maximum_lateral_acc) {
+    c.fail("maximum_lateral_acc", "must be >= minimum_lateral_acc (" + text(p.minimum_lateral_acc) + "), got " +
+                                      text(p.maximum_lateral_acc));
+  }
+  c.positive("maximum_curvature", p.maximum_curvature);
+  c.positive("end_pose_curvature_threshold", p.end_pose_curvature_threshold);
+  c.positive("maximum_longitudinal_acc", p.maximum_longitudinal_acc);
+  return issues;
+}
+
+std::vector<ParameterIssue> validate_vehicle(const VehicleInfo& v) {
+  std::vector<ParameterIssue> issues;
+  Checker c(issues);
+  c.in_range("wheel_base", v.wheel_base_m, 0.1, 20.0);
+  c.in_range("wheel_tread", v.wheel_tread_m, 0.1, 5.0);
+  c.in_range("front_overhang", v.front_overhang_m, 0.0, 10.0);
+  c.in_range("rear_overhang", v.rear_overhang_m, 0.0, 10.0);
+  c.in_range("left_overhang", v.left_overhang_m, 0.0, 2.0);
+  c.in_range("right_overhang", v.right_overhang_m, 0.0, 2.0);
+  // Below pi/2 so that the minimum turning radius (wheel_base / tan) is positive and finite.
+  c.in_range("max_steer_angle", v.max_steer_angle_rad, 0.01, 1.5);
+  return issues;
+}
+
+}  // namespace pullout

@@ -1,0 +1,225 @@
+#include "pullout/pipeline/start_planner.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "pullout/collision/footprint.hpp"
+#include "pullout/collision/object_checker.hpp"
+#include "pullout/lanes/lane_world.hpp"
+#include "pullout/model/names.hpp"
+#include "pullout/planners/shift_pull_out.hpp"
+#include "validation.hpp"
+
+namespace pullout {
+
+namespace {
+
+const std::vector<PlannerType>& available_planners() {
+  static const std::vector<PlannerType> kAvailable{PlannerType::kShift};
+  return kAvailable;
+}
+
+std::unique_ptr<PullOutPlanner> make_planner(PlannerType type) {
+  switch (type) {
+    case PlannerType::kShift:
+      return std::make_unique<ShiftPullOut>();
+    default:
+      return nullptr;
+  }
+}
+
+std::string format_margin(double m) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(2);
+  os << m;
+  return os.str();
+}
+
+// The start pose must lie on a lane; a vehicle half a width outside still counts (it may stand
+// partly on the kerb), further away it is not on this request's lanes at all.
+std::optional<RequestIssue> check_start_on_lanes(const LaneWorld& world, const Pose2& ego, const VehicleInfo& v) {
+  const Vec2 p = to_vec(ego);
+  if (world.contains(p)) return std::nullopt;
+  double nearest = std::numeric_limits<double>::infinity();
+  std::int64_t nearest_id = 0;
+  for (const LaneGeometry& lane : world.lanes()) {
+    const Polygon& poly = lane.polygon;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const double d = distance_to_segment(p, poly[i], poly[(i + 1) % poly.size()]);
+      if (d < nearest) {
+        nearest = d;
+        nearest_id = lane.id;
+      }
+    }
+  }
+  if (nearest <= v.width_m() / 2.0) return std::nullopt;
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(2);
+  os << "(" << ego.x << ", " << ego.y << ") is on no lane; the nearest, lane " << nearest_id << ", is " << nearest
+     << " m away";
+  return RequestIssue{"ego_pose", os.str()};
+}
+
+PullOutPath make_stop_path(const PullOutRequest& request) {
+  PullOutPath path;
+  path.found = false;
+  path.planner_type = PlannerType::kStop;
+  PathWithLaneId stop;
+  PathPoint point;
+  point.pose = request.ego_pose;
+  point.longitudinal_velocity_mps = 0.0;
+  stop.points = {point, point};
+  path.partial_paths.push_back(std::move(stop));
+  path.pairs_terminal_velocity_and_accel.push_back({0.0, 0.0});
+  path.start_pose = request.ego_pose;
+  path.end_pose = request.ego_pose;
+  return path;
+}
+
+// One line per planner: the outcomes at the last margin tried (the least demanding one).
+std::vector<std::string> no_path_reasons(const std::vector<PlannerAttempt>& attempts) {
+  std::vector<std::string> reasons;
+  if (attempts.empty()) return reasons;
+  const double last_margin = attempts.back().margin_m;
+  for (const PlannerAttempt& a : attempts) {
+    if (a.margin_m != last_margin) continue;
+    reasons.push_back(std::string(to_string(a.planner)) + " at margin " + format_margin(a.margin_m) +
+                      " m, backward " + format_margin(a.backward_distance_m) + " m: " + a.outcome);
+  }
+  return reasons;
+}
+
+}  // namespace
+
+bool planner_available(PlannerType type) {
+  const auto& a = available_planners();
+  return std::find(a.begin(), a.end(), type) != a.end();
+}
+
+StartPlanner::StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits)
+    : vehicle_(vehicle), parameters_(std::move(parameters)), limits_(limits) {}
+
+std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) const {
+  auto issues = validate_request_structure(request, limits_, available_planners());
+  if (!issues.empty()) return issues;
+  const LaneWorld world(request.lanes);
+  if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) issues.push_back(*issue);
+  return issues;
+}
+
+PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline& deadline) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  PlanningResult result;
+  const auto finish = [&](PlanningResult& r) {
+    r.planning_time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    r.path.vehicle_id = request.vehicle_id;
+    r.path.request_id = request.request_id;
+    r.path.stamp_ns = request.stamp_ns;
+  };
+
+  result.issues = validate_request_structure(request, limits_, available_planners());
+  if (!result.issues.empty()) {
+    result.outcome = PlanningResult::Outcome::kRejected;
+    finish(result);
+    return result;
+  }
+  const LaneWorld world(request.lanes);
+  if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) {
+    result.issues.push_back(*issue);
+    result.outcome = PlanningResult::Outcome::kRejected;
+    finish(result);
+    return result;
+  }
+
+  StartPlannerParameters params = parameters_;
+  if (!request.overrides.search_priority.empty()) params.search_priority = request.overrides.search_priority;
+  if (request.overrides.search_policy) params.search_policy = *request.overrides.search_policy;
+
+  // The road lanes to pull out onto: the chain through the road lane nearest to the vehicle.
+  const auto seed = world.nearest_lane(to_vec(request.ego_pose), LaneSubtype::kRoad);
+  const LaneChain road = world.chain_through(*seed);  // validation guarantees a road lane
+
+  // Static obstacles: objects slower than th_moving_object_velocity, of the classes to check.
+  // All of them are considered, wherever they stand (Autoware keeps only those overlapping the
+  // pull-out lanes, which misses a car standing half on the kerb next to the path).
+  std::vector<Obstacle> obstacles;
+  for (const Object& o : request.objects) {
+    if (std::abs(o.velocity_mps) >= params.th_moving_object_velocity) continue;
+    if (!params.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
+    obstacles.push_back({o.id, object_polygon(o)});
+  }
+  const ObjectChecker checker(vehicle_footprint(vehicle_), std::move(obstacles));
+  const PlanningContext context{world, road, checker, vehicle_, params, request.goal_pose};
+
+  std::vector<std::unique_ptr<PullOutPlanner>> planners;
+  for (PlannerType t : params.search_priority) {
+    if (auto p = make_planner(t)) planners.push_back(std::move(p));
+  }
+  // Start candidates: the current pose only (backward start-pose search is a later extension).
+  struct StartCandidate {
+    Pose2 pose;
+    double backward_distance;
+  };
+  const std::vector<StartCandidate> starts{{request.ego_pose, 0.0}};
+  // The order of (candidate, planner) pairs inside one margin, per search_policy.
+  std::vector<std::pair<std::size_t, std::size_t>> order;
+  if (params.search_policy == SearchPolicy::kPlannerPriority) {
+    for (std::size_t p = 0; p < planners.size(); ++p) {
+      for (std::size_t c = 0; c < starts.size(); ++c) order.emplace_back(c, p);
+    }
+  } else {
+    for (std::size_t c = 0; c < starts.size(); ++c) {
+      for (std::size_t p = 0; p < planners.size(); ++p) order.emplace_back(c, p);
+    }
+  }
+
+  for (double margin : params.collision_check_margins) {
+    for (const auto& [ci, pi] : order) {
+      if (deadline.expired()) {
+        result.timed_out = true;
+        break;
+      }
+      const StartCandidate& start = starts[ci];
+      PlannerOutput out = planners[pi]->plan(context, start.pose, margin, deadline);
+      if (out.outcome == "timeout") result.timed_out = true;
+      result.evaluation_table.push_back({planners[pi]->type(), margin, start.backward_distance, out.outcome});
+      if (out.path) {
+        result.outcome = PlanningResult::Outcome::kFound;
+        result.path = std::move(*out.path);
+        result.path.found = true;
+        result.path.planner_type = planners[pi]->type();
+        // The vehicle moves towards the centerline: right when it starts left of it.
+        result.path.turn_signal = result.path.shift_length_m > 0.0   ? TurnSignal::kRight
+                                  : result.path.shift_length_m < 0.0 ? TurnSignal::kLeft
+                                                                     : TurnSignal::kNone;
+        finish(result);
+        return result;
+      }
+    }
+    if (result.timed_out) break;
+  }
+
+  result.outcome = PlanningResult::Outcome::kNoPath;
+  result.path = make_stop_path(request);
+  result.path.reasons = no_path_reasons(result.evaluation_table);
+  if (result.timed_out) {
+    std::ostringstream os;
+    os << "planning deadline exceeded after " << result.evaluation_table.size() << " attempts";
+    result.stop_reason = os.str();
+    result.path.reasons.push_back(result.stop_reason);
+  } else if (planners.empty()) {
+    result.stop_reason = "no planner enabled";
+    result.path.reasons.push_back(result.stop_reason);
+  } else {
+    result.stop_reason = "no safe path at any collision margin";
+  }
+  finish(result);
+  return result;
+}
+
+}  // namespace pullout

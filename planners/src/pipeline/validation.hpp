@@ -1,0 +1,16 @@
+// Internal: request validation steps used by StartPlanner.
+#pragma once
+
+#include <vector>
+
+#include "pullout/model/types.hpp"
+#include "pullout/pipeline/parameters.hpp"
+
+namespace pullout {
+
+// Checks that need no world: finite numbers, sizes within the limits, non-degenerate lanes,
+// known planners.
+std::vector<RequestIssue> validate_request_structure(const PullOutRequest& request, const RequestLimits& limits,
+                                                     const std::vector<PlannerType>& available);
+
+}  // namespace pullout

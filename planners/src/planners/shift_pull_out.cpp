@@ -1,0 +1,341 @@
+#include "pullout/planners/shift_pull_out.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "pullout/collision/footprint.hpp"
+
+namespace pullout {
+
+namespace {
+
+constexpr double kMinShiftLength = 0.01;          // [m] below this the start is on the centerline
+constexpr double kMaxStartYawDeviation = 0.35;    // [rad] (20 deg) between start heading and lane
+constexpr double kGoalOnRoadTolerance = 0.5;      // [m] lateral offset of a goal on the centerline
+
+std::string format_double(double v, int precision = 2) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(precision);
+  os << v;
+  return os.str();
+}
+
+// Arc length where the shift may end: the first centerline position at or after s0 whose
+// curvature is below the threshold, or the least curved one if none is (so that the shift does
+// not end in the middle of a bend).
+double push_end_to_low_curvature(const Polyline& center, double s0, double threshold) {
+  if (std::abs(center.curvature_at(s0)) < threshold) return s0;
+  double best_s = s0;
+  double best_k = std::abs(center.curvature_at(s0));
+  for (std::size_t i = 0; i < center.size(); ++i) {
+    if (center.s(i) <= s0) continue;
+    const double k = std::abs(center.curvature_at(center.s(i)));
+    if (k < threshold) return center.s(i);
+    if (k < best_k) {
+      best_k = k;
+      best_s = center.s(i);
+    }
+  }
+  return best_s;
+}
+
+// Lateral offset l and its derivative dl/ds of the shifted path at centerline arc length s.
+struct Offset {
+  double l{0.0};
+  double dl{0.0};
+};
+
+class ShiftShape {
+ public:
+  ShiftShape(const LateralJerkProfile& profile, double shift_length, double s_begin, double length)
+      : profile_(profile),
+        total_(profile.at(profile.total_time()).position),
+        shift_length_(shift_length),
+        s_begin_(s_begin),
+        length_(length) {}
+
+  Offset at(double s) const {
+    if (s >= s_begin_ + length_) return {};
+    const double u = std::clamp((s - s_begin_) / length_, 0.0, 1.0);
+    const double time = u * profile_.total_time();
+    const auto st = profile_.at(time);
+    const double p = st.position / total_;
+    const double dp_du = st.velocity * profile_.total_time() / total_;
+    return {shift_length_ * (1.0 - p), -shift_length_ * dp_du / length_};
+  }
+
+  double end() const { return s_begin_ + length_; }
+
+ private:
+  LateralJerkProfile profile_;
+  double total_;
+  double shift_length_;
+  double s_begin_;
+  double length_;
+};
+
+Pose2 shifted_pose(const Polyline& center, double s, const Offset& o) {
+  const Vec2 base = center.point_at(s);
+  const double yaw_c = center.yaw_at(s);
+  const double k = center.curvature_at(s);
+  const Vec2 p = base + left_normal(heading(yaw_c)) * o.l;
+  // Tangent of base + n(s) l(s): t (1 - k l) + n l'.
+  return {p.x(), p.y(), normalize_angle(yaw_c + std::atan2(o.dl, 1.0 - k * o.l))};
+}
+
+// Path length of the shifted section over centerline length `length` from s_begin.
+double shifted_length(const Polyline& center, const ShiftShape& shape, double s_begin, double length) {
+  constexpr int kSteps = 64;
+  double total = 0.0;
+  Vec2 prev = to_vec(shifted_pose(center, s_begin, shape.at(s_begin)));
+  for (int i = 1; i <= kSteps; ++i) {
+    const double s = s_begin + length * i / kSteps;
+    const Vec2 p = to_vec(shifted_pose(center, s, shape.at(s)));
+    total += (p - prev).norm();
+    prev = p;
+  }
+  return total;
+}
+
+struct RoadEnd {
+  double s{0.0};
+  bool is_goal{false};
+};
+
+RoadEnd find_path_end(const PlanningContext& ctx, double s_start) {
+  const Polyline& center = ctx.road.centerline;
+  RoadEnd end{std::min(s_start + ctx.parameters.forward_path_length, center.length()), false};
+  const auto g = center.project(to_vec(ctx.goal));
+  if (std::abs(g.lateral) <= kGoalOnRoadTolerance && g.s > s_start && g.s <= end.s) end = {g.s, true};
+  return end;
+}
+
+std::vector<std::int64_t> lane_ids_at(const PlanningContext& ctx, const Vec2& p, double s) {
+  std::vector<std::int64_t> ids;
+  for (std::size_t i : ctx.world.lanes_containing(p)) ids.push_back(ctx.world.lanes()[i].id);
+  if (ids.empty()) ids.push_back(ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(s)]].id);
+  return ids;
+}
+
+double speed_limit_at(const PlanningContext& ctx, double s) {
+  return ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(s)]].speed_limit_mps;
+}
+
+struct Candidate {
+  PathWithLaneId path;
+  std::vector<Pose2> poses;
+  std::vector<double> s;  // centerline arc length of each point
+  std::size_t shift_end_index{0};
+};
+
+// Samples the shifted centerline from s_start to s_end every center_line_path_interval, with the
+// shift end included exactly.
+Candidate sample_path(const PlanningContext& ctx, const ShiftShape& shape, double s_start, const RoadEnd& end,
+                      double v_term) {
+  const Polyline& center = ctx.road.centerline;
+  const double step = ctx.parameters.center_line_path_interval;
+  std::vector<double> ss;
+  for (double s = s_start; s < end.s - 1e-6; s += step) ss.push_back(s);
+  ss.push_back(end.s);
+  if (shape.end() > s_start && shape.end() < end.s) {
+    const auto it = std::lower_bound(ss.begin(), ss.end(), shape.end());
+    if (std::abs(*it - shape.end()) > 1e-6 && (it == ss.begin() || std::abs(*(it - 1) - shape.end()) > 1e-6)) {
+      ss.insert(it, shape.end());
+    }
+  }
+  Candidate c;
+  c.path.points.reserve(ss.size());
+  c.poses.reserve(ss.size());
+  c.shift_end_index = ss.size() - 1;
+  for (std::size_t i = 0; i < ss.size(); ++i) {
+    const double s = ss[i];
+    const Pose2 pose = shifted_pose(center, s, shape.at(s));
+    if (s <= shape.end() + 1e-9) c.shift_end_index = i;
+    PathPoint pt;
+    pt.pose = pose;
+    const double limit = speed_limit_at(ctx, s);
+    pt.longitudinal_velocity_mps = s <= shape.end() + 1e-9 ? std::min(limit, v_term) : limit;
+    pt.lane_ids = lane_ids_at(ctx, to_vec(pose), s);
+    c.poses.push_back(pose);
+    c.s.push_back(s);
+    c.path.points.push_back(std::move(pt));
+  }
+  if (end.is_goal) c.path.points.back().longitudinal_velocity_mps = 0.0;
+  return c;
+}
+
+// Lane departure of the footprint over poses [0, last]; returns the first departing index.
+std::optional<std::size_t> first_departure(const PlanningContext& ctx, const std::vector<Pose2>& poses,
+                                           std::size_t last) {
+  const Footprint fp = vehicle_footprint(ctx.vehicle, ctx.parameters.lane_departure_check_expansion_margin);
+  for (std::size_t i = 0; i <= last && i < poses.size(); ++i) {
+    if (!ctx.world.footprint_inside(footprint_corners(fp, poses[i]))) return i;
+  }
+  return std::nullopt;
+}
+
+bool lane_departure_check_required(const PlanningContext& ctx, const Pose2& first) {
+  const auto& p = ctx.parameters;
+  if (!p.check_shift_path_lane_departure) return false;
+  if (!p.allow_check_shift_path_lane_departure_override) return true;
+  // Override: a vehicle already partly outside the lanes may leave them on the way out.
+  const Footprint fp = vehicle_footprint(ctx.vehicle, p.lane_departure_check_expansion_margin);
+  return ctx.world.footprint_inside(footprint_corners(fp, first));
+}
+
+std::string summarize(const std::map<std::string, int>& reasons, int total) {
+  std::string out;
+  for (const auto& [reason, count] : reasons) {
+    if (!out.empty()) out += "; ";
+    out += reason;
+    if (total > 1) out += " (" + std::to_string(count) + "/" + std::to_string(total) + " candidates)";
+  }
+  return out;
+}
+
+}  // namespace
+
+LateralJerkProfile LateralJerkProfile::from_limits(double shift_length, double lateral_jerk, double lateral_acc) {
+  const double L = std::abs(shift_length);
+  const double j = lateral_jerk;
+  const double a = lateral_acc;
+  LateralJerkProfile p{j, a / j, (std::sqrt(a * a + 4.0 * j * j * L / a) - 3.0 * a) / (2.0 * j)};
+  if (p.t_accel < 0.0) {
+    // The acceleration limit is never reached: a pure jerk profile (peak j t_j < a).
+    p.t_jerk = std::cbrt(L / (2.0 * j));
+    p.t_accel = 0.0;
+  }
+  return p;
+}
+
+LateralJerkProfile::State LateralJerkProfile::at(double t) const {
+  const double durations[6] = {t_jerk, t_accel, t_jerk, t_jerk, t_accel, t_jerk};
+  const double jerks[6] = {jerk, 0.0, -jerk, -jerk, 0.0, jerk};
+  State s;
+  double remaining = std::clamp(t, 0.0, total_time());
+  for (int k = 0; k < 6 && remaining > 0.0; ++k) {
+    const double dt = std::min(remaining, durations[k]);
+    const double jk = jerks[k];
+    s.position += s.velocity * dt + s.acceleration * dt * dt / 2.0 + jk * dt * dt * dt / 6.0;
+    s.velocity += s.acceleration * dt + jk * dt * dt / 2.0;
+    s.acceleration += jk * dt;
+    remaining -= dt;
+  }
+  return s;
+}
+
+double calc_shift_time_from_jerk(double shift_length, double lateral_jerk, double lateral_acc) {
+  if (lateral_jerk <= 0.0 || lateral_acc <= 0.0) return std::numeric_limits<double>::infinity();
+  return LateralJerkProfile::from_limits(shift_length, lateral_jerk, lateral_acc).total_time();
+}
+
+ShiftKinematics compute_shift_kinematics(double shift_length, double lateral_acc, double road_velocity,
+                                         const StartPlannerParameters& p) {
+  ShiftKinematics k;
+  k.lateral_acc = lateral_acc;
+  k.profile = LateralJerkProfile::from_limits(shift_length, p.lateral_jerk, lateral_acc);
+  k.shift_time = k.profile.total_time();
+  const double T = k.shift_time;
+  k.longitudinal_acc = std::clamp(road_velocity / T, 0.0, p.maximum_longitudinal_acc);
+  const double by_acceleration = 0.5 * k.longitudinal_acc * T * T;
+  const double by_curvature = T * std::sqrt(k.profile.peak_acceleration() / p.maximum_curvature);
+  k.distance = std::max({by_acceleration, by_curvature, p.minimum_shift_pull_out_distance});
+  k.terminal_velocity = std::min(road_velocity, std::sqrt(2.0 * k.longitudinal_acc * k.distance));
+  return k;
+}
+
+std::vector<double> lateral_acc_samples(const StartPlannerParameters& p) {
+  std::vector<double> out;
+  const int n = std::max(p.lateral_acceleration_sampling_num, 1);
+  if (p.maximum_lateral_acc - p.minimum_lateral_acc < 1e-9) return {p.minimum_lateral_acc};
+  for (int i = 0; i <= n; ++i) {
+    out.push_back(p.minimum_lateral_acc + (p.maximum_lateral_acc - p.minimum_lateral_acc) * i / n);
+  }
+  return out;
+}
+
+PlannerOutput ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start, double margin,
+                                 const Deadline& deadline) const {
+  const auto& params = ctx.parameters;
+  const Polyline& center = ctx.road.centerline;
+  if (center.size() < 2) return {std::nullopt, "no road centerline"};
+  const auto proj = center.project(to_vec(start));
+  const double s_start = proj.s;
+  const double shift_length = proj.lateral;
+  if (s_start < 0.0 || s_start >= center.length()) return {std::nullopt, "start pose is not alongside the road lanes"};
+  const double yaw_dev = normalize_angle(start.yaw - center.yaw_at(s_start));
+  if (std::abs(yaw_dev) > kMaxStartYawDeviation) {
+    return {std::nullopt, "start heading deviates " + format_double(yaw_dev * 180.0 / M_PI, 1) +
+                              " deg from the road (limit " + format_double(kMaxStartYawDeviation * 180.0 / M_PI, 0) +
+                              ")"};
+  }
+  const RoadEnd end = find_path_end(ctx, s_start);
+  const double v_road = speed_limit_at(ctx, s_start);
+
+  std::vector<ShiftKinematics> candidates;
+  if (std::abs(shift_length) < kMinShiftLength) {
+    // Already on the centerline: drive straight on, accelerating towards the speed limit.
+    ShiftKinematics straight;
+    straight.longitudinal_acc = params.maximum_longitudinal_acc;
+    straight.terminal_velocity = v_road;
+    candidates.push_back(straight);
+  } else {
+    for (double a_lat : lateral_acc_samples(params)) {
+      candidates.push_back(compute_shift_kinematics(shift_length, a_lat, v_road, params));
+    }
+  }
+
+  std::map<std::string, int> failures;
+  for (const ShiftKinematics& k : candidates) {
+    if (deadline.expired()) return {std::nullopt, "timeout"};
+    double length = k.distance;
+    std::optional<ShiftShape> shape;
+    if (k.distance > 0.0) {
+      // Centerline length whose shifted section is k.distance long (differs on curves).
+      for (int iter = 0; iter < 2; ++iter) {
+        const ShiftShape trial(k.profile, shift_length, s_start, length);
+        length *= k.distance / shifted_length(center, trial, s_start, length);
+      }
+      const double s_end = push_end_to_low_curvature(center, s_start + length, params.end_pose_curvature_threshold);
+      if (s_end > end.s - 1e-6) {
+        ++failures[end.is_goal ? "goal too close for the shift" : "road lanes too short for the shift"];
+        continue;
+      }
+      shape.emplace(k.profile, shift_length, s_start, s_end - s_start);
+    } else {
+      shape.emplace(k.profile, 0.0, s_start, 0.0);
+    }
+    Candidate c = sample_path(ctx, *shape, s_start, end, k.terminal_velocity);
+
+    if (lane_departure_check_required(ctx, c.poses.front())) {
+      if (const auto i = first_departure(ctx, c.poses, c.shift_end_index)) {
+        ++failures["lane departure"];
+        continue;
+      }
+    }
+    // Collision section: from the start to end_pose + shift_collision_check_distance_from_end.
+    const double s_check_end = shape->end() + params.shift_collision_check_distance_from_end;
+    std::size_t last = 0;
+    while (last + 1 < c.s.size() && c.s[last + 1] <= s_check_end) ++last;
+    const std::vector<Pose2> section(c.poses.begin(), c.poses.begin() + static_cast<long>(last) + 1);
+    if (const auto hit = ctx.objects.first_hit(section, margin)) {
+      ++failures["collision with object " + std::to_string(hit->obstacle_id)];
+      continue;
+    }
+
+    PullOutPath path;
+    path.start_pose = c.poses.front();
+    path.end_pose = c.poses[c.shift_end_index];
+    path.shift_length_m = std::abs(shift_length) < kMinShiftLength ? 0.0 : shift_length;
+    path.partial_paths.push_back(std::move(c.path));
+    path.pairs_terminal_velocity_and_accel.push_back({k.terminal_velocity, k.longitudinal_acc});
+    return {std::move(path), "success"};
+  }
+  return {std::nullopt, summarize(failures, static_cast<int>(candidates.size()))};
+}
+
+}  // namespace pullout
