@@ -15,6 +15,7 @@ namespace {
 constexpr double kMinShiftLength = 0.01;          // [m] below this the start is on the centerline
 constexpr double kMaxStartYawDeviation = 0.35;    // [rad] (20 deg) between start heading and lane
 constexpr double kGoalOnRoadTolerance = 0.5;      // [m] lateral offset of a goal on the centerline
+constexpr double kTouchingDistance = 1e-6;        // [m] clearance below this is contact
 
 std::string format_double(double v, int precision = 2) {
   std::ostringstream os;
@@ -324,6 +325,14 @@ PlannerOutput ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start,
     const std::vector<Pose2> section(c.poses.begin(), c.poses.begin() + static_cast<long>(last) + 1);
     if (const auto hit = ctx.objects.first_hit(section, margin)) {
       ++failures["collision with object " + std::to_string(hit->obstacle_id)];
+      continue;
+    }
+    // Past the section, up to the end pose, the margin is not required (Autoware stops checking
+    // there altogether), but the footprint must still not touch an obstacle.
+    const std::vector<Pose2> rest(c.poses.begin() + static_cast<long>(last) + 1,
+                                  c.poses.begin() + static_cast<long>(std::max(last, c.shift_end_index)) + 1);
+    if (const auto hit = ctx.objects.first_hit(rest, kTouchingDistance)) {
+      ++failures["collision with object " + std::to_string(hit->obstacle_id) + " near the end pose"];
       continue;
     }
 

@@ -25,7 +25,9 @@
 //   a_lon T otherwise).
 // - The static collision check is never skipped (Autoware skips it for shifts < 0.5 m and ignores
 //   zero-speed objects when enable_back is false), and the checked section always contains the
-//   start pose even when end_pose + shift_collision_check_distance_from_end lies behind it.
+//   start pose even when end_pose + shift_collision_check_distance_from_end lies behind it. Past
+//   that section, up to the end pose, the margin is not required but contact still is a collision
+//   (Autoware does not check there at all).
 #pragma once
 
 #include "pullout/planners/pull_out_planner.hpp"

@@ -1,0 +1,172 @@
+#include "pullout/pipeline/start_planner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "pullout/collision/footprint.hpp"
+#include "pullout/collision/object_checker.hpp"
+#include "test_world.hpp"
+
+namespace pullout {
+namespace {
+
+const StartPlanner& default_planner() {
+  static const StartPlanner planner(VehicleInfo{}, StartPlannerParameters{});
+  return planner;
+}
+
+bool has_issue(const PlanningResult& r, const std::string& field) {
+  for (const auto& i : r.issues) {
+    if (i.field == field) return true;
+  }
+  return false;
+}
+
+// Smallest clearance of the footprint along the path up to the end pose.
+double min_clearance(const PullOutPath& path, const std::vector<Object>& objects) {
+  std::vector<Obstacle> obstacles;
+  for (const auto& o : objects) obstacles.push_back({o.id, object_polygon(o)});
+  const ObjectChecker checker(vehicle_footprint(VehicleInfo{}), obstacles);
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& seg : path.partial_paths) {
+    for (const auto& pt : seg.points) {
+      best = std::min(best, checker.clearance(pt.pose).distance);
+      if (std::hypot(pt.pose.x - path.end_pose.x, pt.pose.y - path.end_pose.y) < 1e-9) return best;
+    }
+  }
+  return best;
+}
+
+TEST(StartPlanner, ParkedCarAheadForcesASmallerMargin) {
+  auto req = test::straight_shoulder_request();
+  req.objects.push_back(test::parked_car(7, 24.0, 3.25));
+  const PlanningResult r = default_planner().plan(req, Deadline());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  // Every larger margin was tried first and failed for the car.
+  ASSERT_GE(r.evaluation_table.size(), 2u);
+  for (std::size_t i = 0; i + 1 < r.evaluation_table.size(); ++i) {
+    EXPECT_NE(r.evaluation_table[i].outcome.find("collision with object 7"), std::string::npos);
+  }
+  const PlannerAttempt& winner = r.evaluation_table.back();
+  EXPECT_EQ(winner.outcome, "success");
+  EXPECT_LT(winner.margin_m, 2.0);
+  // The path never touches the car (independent check over the whole path to the end pose).
+  EXPECT_GT(min_clearance(r.path, req.objects), 0.0);
+}
+
+TEST(StartPlanner, BoxedInGivesAStopPathWithEveryAttemptsReason) {
+  auto req = test::straight_shoulder_request();
+  req.objects.push_back(test::parked_car(7, 16.5, 3.25));  // 0.46 m ahead of the bumper
+  req.objects.push_back(test::parked_car(8, 5.0, 3.25));   // behind
+  const PlanningResult r = default_planner().plan(req, Deadline());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  EXPECT_FALSE(r.path.found);
+  EXPECT_EQ(r.path.planner_type, PlannerType::kStop);
+  ASSERT_EQ(r.path.partial_paths.size(), 1u);
+  EXPECT_EQ(r.path.pairs_terminal_velocity_and_accel.size(), 1u);
+  for (const auto& pt : r.path.partial_paths[0].points) {
+    EXPECT_DOUBLE_EQ(pt.longitudinal_velocity_mps, 0.0);
+    EXPECT_DOUBLE_EQ(pt.pose.x, req.ego_pose.x);
+  }
+  EXPECT_EQ(r.evaluation_table.size(), StartPlannerParameters{}.collision_check_margins.size());
+  for (const auto& a : r.evaluation_table) EXPECT_NE(a.outcome.find("collision"), std::string::npos);
+  ASSERT_FALSE(r.path.reasons.empty());
+  EXPECT_NE(r.path.reasons[0].find("margin 0.10"), std::string::npos) << r.path.reasons[0];
+  EXPECT_FALSE(r.stop_reason.empty());
+}
+
+TEST(StartPlanner, MovingObjectsAreNotStaticObstacles) {
+  auto req = test::straight_shoulder_request();
+  Object passing = test::parked_car(7, 16.5, 3.25);
+  passing.velocity_mps = 5.0;
+  req.objects.push_back(passing);
+  EXPECT_EQ(default_planner().plan(req, Deadline()).outcome, PlanningResult::Outcome::kFound);
+}
+
+TEST(StartPlanner, ExpiredDeadlineEndsTheSearchWithTimeout) {
+  auto req = test::straight_shoulder_request();
+  const PlanningResult r = default_planner().plan(req, Deadline::after_ms(0.0));
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  EXPECT_TRUE(r.timed_out);
+  EXPECT_NE(r.stop_reason.find("deadline"), std::string::npos);
+  EXPECT_FALSE(r.path.found);
+}
+
+TEST(StartPlanner, SearchPolicyOverrideAndUnavailablePlanner) {
+  auto req = test::straight_shoulder_request();
+  req.overrides.search_priority = {PlannerType::kGeometric};
+  const PlanningResult r = default_planner().plan(req, Deadline());
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
+  EXPECT_TRUE(has_issue(r, "overrides.search_priority[0]"));
+}
+
+TEST(StartPlannerValidation, NonFiniteValuesNameTheField) {
+  auto req = test::straight_shoulder_request();
+  req.ego_pose.x = std::numeric_limits<double>::quiet_NaN();
+  req.goal_pose.yaw = std::numeric_limits<double>::infinity();
+  req.lanes[1].left_bound[1].y = std::numeric_limits<double>::quiet_NaN();
+  const PlanningResult r = default_planner().plan(req, Deadline());
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
+  EXPECT_TRUE(has_issue(r, "ego_pose.x"));
+  EXPECT_TRUE(has_issue(r, "goal_pose.yaw"));
+  EXPECT_TRUE(has_issue(r, "lanes[1].left_bound[1]"));
+  EXPECT_NE(format_issues(r.issues).find("ego_pose.x: not a finite number (NaN)"), std::string::npos);
+}
+
+TEST(StartPlannerValidation, EmptyAndDegenerateLanes) {
+  auto req = test::straight_shoulder_request();
+  req.lanes.clear();
+  EXPECT_TRUE(has_issue(default_planner().plan(req, Deadline()), "lanes"));
+
+  req = test::straight_shoulder_request();
+  req.lanes[0].right_bound = req.lanes[0].left_bound;  // zero area
+  req.lanes[1].left_bound.resize(1);
+  const PlanningResult r = default_planner().plan(req, Deadline());
+  EXPECT_TRUE(has_issue(r, "lanes[0]"));
+  EXPECT_TRUE(has_issue(r, "lanes[1].left_bound"));
+
+  req = test::straight_shoulder_request();
+  req.lanes[0].subtype = LaneSubtype::kRoadShoulder;
+  EXPECT_TRUE(has_issue(default_planner().plan(req, Deadline()), "lanes"));
+
+  req = test::straight_shoulder_request();
+  req.lanes[1].id = req.lanes[0].id;
+  EXPECT_TRUE(has_issue(default_planner().plan(req, Deadline()), "lanes[1].id"));
+}
+
+TEST(StartPlannerValidation, StartPoseOffTheLanes) {
+  auto req = test::straight_shoulder_request();
+  req.ego_pose = {50.0, 40.0, 0.0};
+  const PlanningResult r = default_planner().plan(req, Deadline());
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
+  ASSERT_TRUE(has_issue(r, "ego_pose"));
+  EXPECT_NE(format_issues(r.issues).find("on no lane"), std::string::npos);
+}
+
+TEST(StartPlannerValidation, SizeLimits) {
+  RequestLimits limits;
+  limits.max_objects = 2;
+  limits.max_points_per_line = 10;
+  const StartPlanner planner(VehicleInfo{}, StartPlannerParameters{}, limits);
+  auto req = test::straight_shoulder_request();
+  for (int i = 0; i < 3; ++i) req.objects.push_back(test::parked_car(i, 60.0 + 6 * i, 3.25));
+  req.lanes[0].left_bound.resize(11, {100.0, 1.75});
+  const auto issues = planner.validate(req);
+  const std::string text = format_issues(issues);
+  EXPECT_NE(text.find("objects: 3 objects exceed the limit of 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("lanes[0].left_bound: 11 points exceed the limit of 10"), std::string::npos) << text;
+}
+
+TEST(StartPlannerValidation, RouteWithoutMapAndBadDeadline) {
+  auto req = test::straight_shoulder_request();
+  req.route_lanelet_ids = {4618};
+  req.deadline_ms = -5.0;
+  const PlanningResult r = default_planner().plan(req, Deadline());
+  EXPECT_TRUE(has_issue(r, "route_lanelet_ids"));
+  EXPECT_TRUE(has_issue(r, "deadline_ms"));
+}
+
+}  // namespace
+}  // namespace pullout
