@@ -206,13 +206,12 @@ bool LaneWorld::footprint_inside(const std::array<Vec2, 4>& corners) const {
   Aabb box;
   for (const Vec2& c : corners) box.extend(c);
   bool crosses = false;
-  std::unordered_set<std::uint32_t> tested;
   for_cells(box, [&](std::int64_t key) {
     if (crosses) return;
     const auto it = edge_cells_.find(key);
     if (it == edge_cells_.end()) return;
+    // An edge spanning several cells is tested once per cell: cheaper than remembering it.
     for (std::uint32_t e : it->second) {
-      if (!tested.insert(e).second) continue;
       const auto& [a, b] = outer_edges_[e];
       for (std::size_t k = 0; k < 4 && !crosses; ++k) {
         crosses = segments_intersect(corners[k], corners[(k + 1) % 4], a, b);

@@ -127,46 +127,47 @@ double speed_limit_at(const PlanningContext& ctx, double s) {
 }
 
 struct Candidate {
-  PathWithLaneId path;
   std::vector<Pose2> poses;
-  std::vector<double> s;  // centerline arc length of each point
+  std::vector<double> s;  // centerline arc length of each pose
   std::size_t shift_end_index{0};
 };
 
-// Samples the shifted centerline from s_start to s_end every center_line_path_interval, with the
-// shift end included exactly.
-Candidate sample_path(const PlanningContext& ctx, const ShiftShape& shape, double s_start, const RoadEnd& end,
-                      double v_term) {
+// Samples the shifted centerline from s_start to the path end every center_line_path_interval,
+// with the shift end included exactly. Only poses: the path points (lane ids, velocities) are
+// built for the winning candidate alone.
+Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, double s_start, const RoadEnd& end) {
   const Polyline& center = ctx.road.centerline;
   const double step = ctx.parameters.center_line_path_interval;
-  std::vector<double> ss;
-  for (double s = s_start; s < end.s - 1e-6; s += step) ss.push_back(s);
-  ss.push_back(end.s);
+  Candidate c;
+  for (double s = s_start; s < end.s - 1e-6; s += step) c.s.push_back(s);
+  c.s.push_back(end.s);
   if (shape.end() > s_start && shape.end() < end.s) {
-    const auto it = std::lower_bound(ss.begin(), ss.end(), shape.end());
-    if (std::abs(*it - shape.end()) > 1e-6 && (it == ss.begin() || std::abs(*(it - 1) - shape.end()) > 1e-6)) {
-      ss.insert(it, shape.end());
+    const auto it = std::lower_bound(c.s.begin(), c.s.end(), shape.end());
+    if (std::abs(*it - shape.end()) > 1e-6 && (it == c.s.begin() || std::abs(*(it - 1) - shape.end()) > 1e-6)) {
+      c.s.insert(it, shape.end());
     }
   }
-  Candidate c;
-  c.path.points.reserve(ss.size());
-  c.poses.reserve(ss.size());
-  c.shift_end_index = ss.size() - 1;
-  for (std::size_t i = 0; i < ss.size(); ++i) {
-    const double s = ss[i];
-    const Pose2 pose = shifted_pose(center, s, shape.at(s));
-    if (s <= shape.end() + 1e-9) c.shift_end_index = i;
-    PathPoint pt;
-    pt.pose = pose;
-    const double limit = speed_limit_at(ctx, s);
-    pt.longitudinal_velocity_mps = s <= shape.end() + 1e-9 ? std::min(limit, v_term) : limit;
-    pt.lane_ids = lane_ids_at(ctx, to_vec(pose), s);
-    c.poses.push_back(pose);
-    c.s.push_back(s);
-    c.path.points.push_back(std::move(pt));
+  c.poses.reserve(c.s.size());
+  for (std::size_t i = 0; i < c.s.size(); ++i) {
+    c.poses.push_back(shifted_pose(center, c.s[i], shape.at(c.s[i])));
+    if (c.s[i] <= shape.end() + 1e-9) c.shift_end_index = i;
   }
-  if (end.is_goal) c.path.points.back().longitudinal_velocity_mps = 0.0;
   return c;
+}
+
+// Velocities: capped at v_term up to the shift end, the lane speed limit after it, 0 at the goal.
+PathWithLaneId to_path(const PlanningContext& ctx, const Candidate& c, const RoadEnd& end, double v_term) {
+  PathWithLaneId path;
+  path.points.resize(c.poses.size());
+  for (std::size_t i = 0; i < c.poses.size(); ++i) {
+    PathPoint& pt = path.points[i];
+    pt.pose = c.poses[i];
+    const double limit = speed_limit_at(ctx, c.s[i]);
+    pt.longitudinal_velocity_mps = i <= c.shift_end_index ? std::min(limit, v_term) : limit;
+    pt.lane_ids = lane_ids_at(ctx, to_vec(pt.pose), c.s[i]);
+  }
+  if (end.is_goal) path.points.back().longitudinal_velocity_mps = 0.0;
+  return path;
 }
 
 // Lane departure of the footprint over poses [0, last]; returns the first departing index.
@@ -310,7 +311,7 @@ PlannerOutput ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start,
     } else {
       shape.emplace(k.profile, 0.0, s_start, 0.0);
     }
-    Candidate c = sample_path(ctx, *shape, s_start, end, k.terminal_velocity);
+    const Candidate c = sample_poses(ctx, *shape, s_start, end);
 
     if (lane_departure_check_required(ctx, c.poses.front())) {
       if (const auto i = first_departure(ctx, c.poses, c.shift_end_index)) {
@@ -340,7 +341,7 @@ PlannerOutput ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start,
     path.start_pose = c.poses.front();
     path.end_pose = c.poses[c.shift_end_index];
     path.shift_length_m = std::abs(shift_length) < kMinShiftLength ? 0.0 : shift_length;
-    path.partial_paths.push_back(std::move(c.path));
+    path.partial_paths.push_back(to_path(ctx, c, end, k.terminal_velocity));
     path.pairs_terminal_velocity_and_accel.push_back({k.terminal_velocity, k.longitudinal_acc});
     return {std::move(path), "success"};
   }

@@ -1,0 +1,182 @@
+#include "commands.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cmath>
+#include <exception>
+#include <optional>
+
+#include "json_output.hpp"
+#include "pullout/client/client.hpp"
+#include "pullout/config/config.hpp"
+#include "pullout/config/scenario.hpp"
+#include "pullout/pipeline/deadline.hpp"
+#include "pullout/pipeline/parameters.hpp"
+#include "pullout/pipeline/start_planner.hpp"
+#include "report.hpp"
+#include "svg_writer.hpp"
+#include "text_output.hpp"
+
+namespace pullout::cli {
+
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+constexpr const char* kDefaultVehicleId = "pullout-cli";
+// Waits are cut into slices so that an interrupt is noticed quickly.
+constexpr auto kWaitSlice = std::chrono::milliseconds(100);
+// After the final status, how long to wait for the path at least (it is published alongside).
+constexpr auto kPathGrace = std::chrono::seconds(1);
+
+std::atomic<bool> g_interrupted{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
+
+extern "C" void handle_interrupt(int /*signal*/) { g_interrupted.store(true); }
+
+// Renders the report on `out` (text or JSON) and writes the SVG. Returns the exit code.
+int emit(const PlanReport& report, const PullOutRequest& request, const VehicleInfo& vehicle,
+         const std::string& scenario_file, const OutputOptions& options, std::ostream& out, std::ostream& err) {
+  if (options.json) {
+    // Strings from the service may hold invalid UTF-8: replace rather than throw.
+    out << to_json(report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+  } else {
+    print_report(out, report);
+  }
+  if (!options.svg_file.empty()) {
+    SvgOptions svg;
+    svg.title = scenario_file + (report.found ? "  (" + std::string(to_string(report.planner)) + ")" : "  (no path)");
+    try {
+      write_text_file(options.svg_file, render_svg(request, vehicle, report.path ? &*report.path : nullptr, svg));
+    } catch (const std::exception& e) {
+      err << "pullout: " << e.what() << '\n';
+      return kExitBadInput;
+    }
+  }
+  return exit_code(report);
+}
+
+bool is_final(const PullOutStatus& status) {
+  return status.state != ExecutionState::kIdle && status.state != ExecutionState::kPlanning;
+}
+
+// Calls `attempt(slice)` until it yields a value, the deadline passes or an interrupt arrives.
+template <typename Attempt>
+auto wait_sliced(SteadyClock::time_point deadline, Attempt attempt) -> decltype(attempt(kWaitSlice)) {
+  while (!g_interrupted.load()) {
+    const auto now = SteadyClock::now();
+    const auto slice = std::min<SteadyClock::duration>(kWaitSlice, std::max(deadline - now, SteadyClock::duration{}));
+    auto result = attempt(std::chrono::duration_cast<Client::Duration>(slice));
+    if (result || SteadyClock::now() >= deadline) return result;
+  }
+  return {};
+}
+
+}  // namespace
+
+void install_interrupt_handlers() {
+  std::signal(SIGINT, handle_interrupt);
+  std::signal(SIGTERM, handle_interrupt);
+}
+
+int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
+  Config config;
+  Scenario scenario;
+  try {
+    if (!options.config_file.empty()) config = load_config(options.config_file);
+    scenario = load_scenario(options.scenario_file, config);
+  } catch (const ConfigError& e) {
+    err << "pullout: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  std::vector<ParameterIssue> issues = validate_vehicle(scenario.vehicle);
+  for (auto& issue : validate_parameters(scenario.parameters)) issues.push_back(std::move(issue));
+  if (!issues.empty()) {
+    for (const auto& issue : issues) {
+      err << "pullout: " << options.scenario_file << ": " << issue.name << ": " << issue.problem << '\n';
+    }
+    return kExitBadInput;
+  }
+
+  const StartPlanner planner(scenario.vehicle, scenario.parameters, config.service.limits);
+  // The service's budget rule: the request's deadline, else the configured default.
+  const double budget_ms =
+      scenario.request.deadline_ms > 0.0 ? scenario.request.deadline_ms : config.service.default_deadline_ms;
+  const PlanningResult result = planner.plan(scenario.request, Deadline::after_ms(budget_ms));
+  return emit(make_report(result), scenario.request, scenario.vehicle, options.scenario_file, options.output, out,
+              err);
+}
+
+int run_request(const RequestOptions& options, std::ostream& out, std::ostream& err) {
+  if (!(options.timeout_s > 0.0) || !std::isfinite(options.timeout_s)) {
+    err << "pullout: --timeout must be a positive number of seconds\n";
+    return kExitBadInput;
+  }
+  Scenario scenario;
+  try {
+    scenario = load_scenario(options.scenario_file);
+  } catch (const ConfigError& e) {
+    err << "pullout: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  const auto deadline =
+      SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(options.timeout_s));
+
+  ClientOptions client_options;
+  client_options.vehicle_id = scenario.request.vehicle_id.empty() ? kDefaultVehicleId : scenario.request.vehicle_id;
+  client_options.domain_id = options.domain_id;
+  client_options.profiles_file = options.profiles_file;
+  std::optional<Client> client;
+  try {
+    client.emplace(client_options);
+  } catch (const std::invalid_argument& e) {
+    err << "pullout: " << e.what() << '\n';
+    return kExitBadInput;
+  } catch (const ClientError& e) {
+    err << "pullout: DDS setup failed: " << e.what() << '\n';
+    return kExitCommunication;
+  }
+
+  const bool matched = wait_sliced(deadline, [&](Client::Duration slice) { return client->wait_for_service(slice); });
+  if (g_interrupted.load()) return kExitInterrupted;
+  if (!matched) {
+    err << "pullout: no pullout service found on DDS domain " << options.domain_id << " within " << options.timeout_s
+        << " s\n";
+    return kExitCommunication;
+  }
+
+  std::uint64_t request_id = 0;
+  try {
+    request_id = client->send(scenario.request);
+  } catch (const ClientError& e) {
+    err << "pullout: " << e.what() << '\n';
+    return kExitCommunication;
+  }
+
+  const auto status = wait_sliced(deadline, [&](Client::Duration slice) {
+    return client->wait_for_status(request_id, is_final, slice);
+  });
+  if (g_interrupted.load()) return kExitInterrupted;
+  if (!status) {
+    err << "pullout: no answer to request " << request_id << " within " << options.timeout_s << " s\n";
+    return kExitCommunication;
+  }
+
+  std::optional<PullOutPath> path;
+  if (status->state != ExecutionState::kRejected) {
+    const auto path_deadline = std::max(deadline, SteadyClock::now() + kPathGrace);
+    path = wait_sliced(path_deadline, [&](Client::Duration slice) { return client->wait_for_path(request_id, slice); });
+    if (g_interrupted.load()) return kExitInterrupted;
+    const bool executing = status->state == ExecutionState::kExecuting || status->state == ExecutionState::kCompleted;
+    if (!path && executing) {
+      err << "pullout: the service reported a path for request " << request_id << " but it did not arrive\n";
+      return kExitCommunication;
+    }
+  }
+  return emit(make_report(path, *status), scenario.request, scenario.vehicle, options.scenario_file, options.output,
+              out, err);
+}
+
+}  // namespace pullout::cli

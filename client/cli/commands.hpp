@@ -1,0 +1,46 @@
+// The two subcommands of the pullout CLI. Each returns the process exit code:
+//   0 a path was found, 1 no path, 2 bad input (unreadable or malformed scenario/config, rejected
+//   request, unwritable SVG), 3 communication failure or timeout (request only), 4 internal error,
+//   130 interrupted (SIGINT/SIGTERM during a request).
+// Results go to `out`; diagnostics (one clear line each) to `err`.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+namespace pullout::cli {
+
+inline constexpr int kExitFound = 0;
+inline constexpr int kExitNoPath = 1;
+inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitCommunication = 3;
+inline constexpr int kExitInternal = 4;
+inline constexpr int kExitInterrupted = 130;
+
+struct OutputOptions {
+  bool json{false};
+  std::string svg_file;  // empty: no SVG
+};
+
+struct PlanOptions {
+  std::string scenario_file;
+  std::string config_file;  // empty: built-in defaults
+  OutputOptions output;
+};
+
+struct RequestOptions {
+  std::string scenario_file;
+  int domain_id{0};
+  std::string profiles_file;  // empty: built-in loopback-only DDS defaults
+  double timeout_s{10.0};     // whole exchange: discovery, planning, reply
+  OutputOptions output;
+};
+
+int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err);
+int run_request(const RequestOptions& options, std::ostream& out, std::ostream& err);
+
+// Makes SIGINT and SIGTERM interrupt run_request's waits (which then return kExitInterrupted)
+// instead of killing the process without deleting its DDS participant.
+void install_interrupt_handlers();
+
+}  // namespace pullout::cli

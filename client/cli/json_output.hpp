@@ -1,0 +1,30 @@
+// The `--json` output of the pullout CLI: ONE JSON object per run.
+//
+//   {
+//     "found": true,
+//     "planner": "shift",                     // pullout::to_string(PlannerType)
+//     "state": "executing",                   // pullout::to_string(ExecutionState)
+//     "segments": [{"points": 42, "direction": "forward" | "reverse",
+//                   "terminal_velocity": 2.7, "terminal_acceleration": 0.0,   // null if unknown
+//                   "length": 40.1}],          // [m/s], [m/s^2], [m]
+//     "start_pose": {"x": 0.0, "y": 0.0, "yaw": 0.0},   // [m], [rad]; null without a path
+//     "end_pose":   {"x": 0.0, "y": 0.0, "yaw": 0.0},
+//     "evaluation_table": [{"planner": "shift", "margin": 2.0, "backward_distance": 0.0,
+//                           "outcome": "collision"}],   // [m]
+//     "planning_time_ms": 3.2,
+//     "reasons": ["..."],                      // why nothing was found; [] when found
+//     "error": ""                              // rejected: "<field>: <problem>" lines
+//   }
+//
+// Non-finite numbers are written as null.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "report.hpp"
+
+namespace pullout::cli {
+
+nlohmann::json to_json(const PlanReport& report);
+
+}  // namespace pullout::cli

@@ -1,0 +1,143 @@
+// pullout::Client: what vehicle software links to talk to the pullout service over DDS.
+//
+// One Client speaks for one vehicle (ClientOptions::vehicle_id). It publishes PullOutRequest and
+// ExecutionProgress samples keyed by that id, and receives the PullOutPath and PullOutStatus
+// replies of that vehicle only (replies for other vehicles are dropped before they reach the
+// reader's history). Path and status readers are transient-local, so a client started after the
+// service replied still receives the vehicle's latest path and status.
+//
+// DDS setup: with an empty ClientOptions::profiles_file the participant and the topic QoS are
+// built in code: loopback only (built-in transports off, one UDPv4 transport whitelisted to
+// 127.0.0.1), and the QoS of DESIGN.md (request: reliable, volatile, keep last 1; path and status:
+// reliable, transient local, keep last 1; progress: reliable, volatile, keep last 1). With a
+// profiles file, the participant comes from the named participant profile (which must exist), and
+// each reader/writer takes the QoS of its profile when the file has one:
+//   pullout_request_writer, pullout_progress_writer, pullout_path_reader, pullout_status_reader
+// else the built-in QoS above. FASTRTPS_DEFAULT_PROFILES_FILE is never consulted for defaults.
+//
+// Threading: every member function is thread-safe. Samples are taken from DDS and callbacks are
+// invoked on one thread owned by the client (not a DDS listener thread), one at a time, in arrival
+// order, with no internal lock held, so a callback may call any member function except the
+// destructor. A slow callback delays later callbacks, not the blocking waits (state is updated
+// before callbacks run). Callbacks must not throw; an exception escaping a callback is caught and
+// reported through the Fast DDS log (category "PULLOUT_CLIENT").
+//
+// Lifetime: the destructor stops the client's thread (waiting for a running callback to return),
+// then deletes every DDS entity. Do not destroy a Client from one of its callbacks, nor while
+// another thread is inside one of its member functions.
+//
+// Units and frames are those of pullout/model/types.hpp. The public headers of this library
+// include no DDS header.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "pullout/client/export.hpp"
+#include "pullout/model/types.hpp"
+
+namespace pullout {
+
+struct ClientOptions {
+  // The vehicle this client speaks for: 1..255 bytes, no NUL character.
+  std::string vehicle_id;
+  // DDS domain, 0..232. The service must use the same domain.
+  int domain_id{0};
+  // Fast DDS XML profiles file. Empty: built-in loopback-only defaults (see above).
+  std::string profiles_file;
+  // Participant profile in profiles_file (ignored when profiles_file is empty).
+  std::string participant_profile{"pullout_participant"};
+};
+
+// A DDS failure: the participant, a topic or an endpoint could not be created, a profiles file
+// could not be loaded, or a sample could not be written.
+class PULLOUT_CLIENT_EXPORT ClientError : public std::runtime_error {
+ public:
+  explicit ClientError(const std::string& what);
+};
+
+class PULLOUT_CLIENT_EXPORT Client {
+ public:
+  using PathCallback = std::function<void(const PullOutPath&)>;
+  using StatusCallback = std::function<void(const PullOutStatus&)>;
+  using StatusPredicate = std::function<bool(const PullOutStatus&)>;
+  using Duration = std::chrono::nanoseconds;
+
+  // Creates the participant, topics, readers and writers. Does not wait for the service (see
+  // wait_for_service). Throws std::invalid_argument for a bad vehicle_id or domain_id, and
+  // ClientError when DDS cannot be set up (the message names what failed).
+  explicit Client(ClientOptions options);
+  ~Client();
+
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
+  Client(Client&&) = delete;
+  Client& operator=(Client&&) = delete;
+
+  // Publishes a request and makes it the current request. Overwrites request.vehicle_id with this
+  // client's vehicle, request.request_id with a fresh id and request.stamp_ns with the system
+  // clock. Ids are strictly increasing within a client and seeded from the system clock [ns], so
+  // they stay unique (and increasing) across client restarts as long as the clock does not step
+  // back. Returns the id. Does not wait for the service: a request sent before the service is
+  // matched is lost (the topic is volatile); call wait_for_service first. Throws ClientError when
+  // the sample cannot be written (e.g. it exceeds the transport's maximum size).
+  std::uint64_t send(PullOutRequest request);
+
+  // Publishes the vehicle's progress. Overwrites progress.vehicle_id; a request_id of 0 becomes
+  // current_request_id(), a stamp_ns of 0 the system clock. Throws std::logic_error when
+  // request_id is 0 and there is no current request, ClientError when the write fails.
+  void report_progress(ExecutionProgress progress);
+
+  // Registers the callback for paths (resp. statuses) of this vehicle, replacing the previous one;
+  // an empty function unregisters. If a path (status) was already received, the new callback is
+  // first invoked once with the latest one, then with every later one. Invoked on the client's
+  // thread. When on_path returns (called from any other thread), the previous callback is not
+  // running and will not be invoked again; called from inside a callback, it takes effect for the
+  // next delivery.
+  void on_path(PathCallback callback);
+  void on_status(StatusCallback callback);
+
+  // Blocks until the path for request_id has been received or the timeout expires. Returns at
+  // once if it is among the recently received paths (the last 16). std::nullopt on timeout.
+  std::optional<PullOutPath> wait_for_path(std::uint64_t request_id, Duration timeout) const;
+
+  // Blocks until a status for request_id satisfies predicate (an empty predicate accepts any),
+  // considering the latest status already received for that request, then each later one. The
+  // predicate runs on the calling thread with an internal lock held: keep it a cheap, pure test.
+  // std::nullopt on timeout. Note: the status reader keeps the last status of the vehicle only,
+  // so short-lived intermediate states may be skipped; wait for the state you need, not for a
+  // transition.
+  std::optional<PullOutStatus> wait_for_status(std::uint64_t request_id, const StatusPredicate& predicate,
+                                               Duration timeout) const;
+
+  // The latest path / status received for this vehicle (whatever request it answers).
+  std::optional<PullOutPath> latest_path() const;
+  std::optional<PullOutStatus> latest_status() const;
+
+  // The request this client follows: the id returned by the last send(), or, before the first
+  // send(), the request of the latest path received (a restarted client adopts it). 0 when none.
+  std::uint64_t current_request_id() const;
+
+  // current_path_idx of the latest status for the current request, when that status says a path
+  // is being executed or completed; std::nullopt otherwise (no status yet, planning, rejected, no
+  // path).
+  std::optional<std::uint32_t> current_segment() const;
+
+  // Blocks until the request writer and the path and status readers are each matched with a
+  // service endpoint, or the timeout expires. Returns whether they are.
+  bool wait_for_service(Duration timeout) const;
+
+  const std::string& vehicle_id() const;
+  int domain_id() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pullout

@@ -1,0 +1,597 @@
+#include "pullout/client/client.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <fastdds/dds/core/condition/GuardCondition.hpp>
+#include <fastdds/dds/core/condition/StatusCondition.hpp>
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/log/Log.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/ContentFilteredTopic.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "dds_qos.hpp"
+#include "pullout/idl/convert.hpp"
+#include "pullout/msg/pulloutPubSubTypes.h"
+#include "vehicle_filter.hpp"
+
+namespace pullout {
+
+ClientError::ClientError(const std::string& what) : std::runtime_error(what) {}
+
+namespace {
+
+namespace dds = eprosima::fastdds::dds;
+using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
+using SteadyClock = std::chrono::steady_clock;
+
+// Content filter parameters travel in discovery as strings of at most 255 characters.
+constexpr std::size_t kMaxVehicleIdBytes = 255;
+constexpr int kMaxDomainId = 232;
+// Replies kept for wait_for_path / wait_for_status. Paths can be several hundred KB each.
+constexpr std::size_t kRecentPaths = 4;
+constexpr std::size_t kRecentStatuses = 32;
+// Reader history depths: more than 1 so that replies arriving back to back are not overwritten
+// before the client's thread takes them. Late joiners still get only the writer's last sample.
+constexpr int kPathReaderDepth = 4;
+constexpr int kStatusReaderDepth = 8;
+constexpr auto kMatchPollPeriod = std::chrono::milliseconds(10);
+
+std::int64_t system_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+void validate_options(const ClientOptions& options) {
+  if (options.vehicle_id.empty()) throw std::invalid_argument("ClientOptions.vehicle_id: must not be empty");
+  if (options.vehicle_id.size() > kMaxVehicleIdBytes) {
+    throw std::invalid_argument("ClientOptions.vehicle_id: longer than " + std::to_string(kMaxVehicleIdBytes) +
+                                " bytes");
+  }
+  if (options.vehicle_id.find('\0') != std::string::npos) {
+    throw std::invalid_argument("ClientOptions.vehicle_id: contains a NUL character");
+  }
+  if (options.domain_id < 0 || options.domain_id > kMaxDomainId) {
+    throw std::invalid_argument("ClientOptions.domain_id: " + std::to_string(options.domain_id) +
+                                " is outside 0.." + std::to_string(kMaxDomainId));
+  }
+}
+
+// A deadline that does not overflow for huge timeouts (Duration::max()).
+SteadyClock::time_point deadline_after(Client::Duration timeout) {
+  const auto now = SteadyClock::now();
+  if (timeout <= Client::Duration::zero()) return now;
+  if (timeout >= SteadyClock::time_point::max() - now) return SteadyClock::time_point::max();
+  return now + std::chrono::duration_cast<SteadyClock::duration>(timeout);
+}
+
+template <typename T>
+struct Received {
+  std::uint64_t seq{0};  // order of reception, from 1
+  std::shared_ptr<const T> value;
+};
+
+template <typename T>
+void push_bounded(std::deque<Received<T>>& queue, Received<T> item, std::size_t bound) {
+  queue.push_back(std::move(item));
+  while (queue.size() > bound) queue.pop_front();
+}
+
+}  // namespace
+
+// Hidden explicitly: a nested class inherits the default visibility of the exported Client.
+class __attribute__((visibility("hidden"))) Client::Impl {
+ public:
+  explicit Impl(ClientOptions options);
+  ~Impl();
+
+  std::uint64_t send(PullOutRequest request);
+  void report_progress(ExecutionProgress progress);
+  void on_path(PathCallback callback);
+  void on_status(StatusCallback callback);
+  std::optional<PullOutPath> wait_for_path(std::uint64_t request_id, Duration timeout) const;
+  std::optional<PullOutStatus> wait_for_status(std::uint64_t request_id, const StatusPredicate& predicate,
+                                               Duration timeout) const;
+  std::optional<PullOutPath> latest_path() const;
+  std::optional<PullOutStatus> latest_status() const;
+  std::uint64_t current_request_id() const;
+  std::optional<std::uint32_t> current_segment() const;
+  bool wait_for_service(Duration timeout) const;
+
+  const ClientOptions& options() const { return options_; }
+
+ private:
+  void create_entities();
+  void destroy_entities() noexcept;
+  dds::DataWriterQos writer_qos(const char* profile) const;
+  dds::DataReaderQos reader_qos(const char* profile, int depth) const;
+  dds::DataReader* create_reply_reader(dds::Topic* topic, const char* profile, int depth);
+
+  void run();
+  void dispatch_once();
+  std::vector<std::shared_ptr<const PullOutPath>> take_paths();
+  std::vector<std::shared_ptr<const PullOutStatus>> take_statuses();
+  bool on_dispatcher_thread() const { return std::this_thread::get_id() == dispatcher_.get_id(); }
+  void wake_dispatcher() { wake_.set_trigger_value(true); }
+
+  const ClientOptions options_;
+
+  // --- DDS entities: created in the constructor, deleted in the destructor. The filter factory is
+  // registered with the participant, so it is declared first (destroyed last). ---
+  client_detail::VehicleIdFilterFactory filter_factory_;
+  dds::DomainParticipant* participant_{nullptr};
+  dds::Publisher* publisher_{nullptr};
+  dds::Subscriber* subscriber_{nullptr};
+  dds::DataWriter* request_writer_{nullptr};
+  dds::DataWriter* progress_writer_{nullptr};
+  dds::DataReader* path_reader_{nullptr};
+  dds::DataReader* status_reader_{nullptr};
+
+  // --- received state, guarded by state_mutex_ ---
+  mutable std::mutex state_mutex_;
+  mutable std::condition_variable state_cv_;
+  std::deque<Received<PullOutPath>> recent_paths_;
+  std::deque<Received<PullOutStatus>> recent_statuses_;
+  std::uint64_t path_seq_{0};
+  std::uint64_t status_seq_{0};
+  std::uint64_t last_request_id_{0};
+  std::uint64_t current_request_id_{0};
+  bool sent_any_{false};
+
+  // --- callbacks, guarded by callback_mutex_, which the dispatcher holds while it delivers ---
+  std::mutex callback_mutex_;
+  PathCallback path_callback_;
+  StatusCallback status_callback_;
+  std::uint64_t path_delivered_seq_{0};    // last path seq given to the current path callback
+  std::uint64_t status_delivered_seq_{0};  // same for statuses
+
+  dds::GuardCondition wake_;
+  std::atomic<bool> stop_{false};
+  std::thread dispatcher_;
+};
+
+// ------------------------------------------------------------------------------------------------
+// Construction and destruction
+
+Client::Impl::Impl(ClientOptions options) : options_(std::move(options)) {
+  validate_options(options_);
+  try {
+    create_entities();
+    dispatcher_ = std::thread([this] { run(); });
+  } catch (...) {
+    destroy_entities();
+    throw;
+  }
+}
+
+Client::Impl::~Impl() {
+  stop_.store(true);
+  wake_dispatcher();
+  if (dispatcher_.joinable()) dispatcher_.join();
+  state_cv_.notify_all();
+  destroy_entities();
+}
+
+void Client::Impl::create_entities() {
+  auto* factory = dds::DomainParticipantFactory::get_instance();
+  dds::DomainParticipantQos participant_qos;
+  if (options_.profiles_file.empty()) {
+    participant_qos = client_detail::loopback_participant_qos();
+  } else {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(options_.profiles_file, ec)) {
+      throw ClientError("DDS profiles file '" + options_.profiles_file + "' does not exist or is not a file");
+    }
+    // Fast DDS only logs a broken file: check the result ourselves.
+    if (factory->load_XML_profiles_file(options_.profiles_file) != ReturnCode::RETCODE_OK) {
+      throw ClientError("DDS profiles file '" + options_.profiles_file + "' could not be loaded (invalid XML?)");
+    }
+    if (factory->get_participant_qos_from_profile(options_.participant_profile, participant_qos) !=
+        ReturnCode::RETCODE_OK) {
+      throw ClientError("participant profile '" + options_.participant_profile + "' not found in '" +
+                        options_.profiles_file + "'");
+    }
+  }
+  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(options_.domain_id), participant_qos);
+  if (participant_ == nullptr) {
+    throw ClientError("cannot create a DDS participant on domain " + std::to_string(options_.domain_id));
+  }
+  if (participant_->register_content_filter_factory(client_detail::kVehicleFilterClass, &filter_factory_) !=
+      ReturnCode::RETCODE_OK) {
+    throw ClientError("cannot register the vehicle content filter");
+  }
+
+  // TypeSupport takes ownership of the type object it is given.
+  const auto register_type = [this](dds::TopicDataType* type) {
+    dds::TypeSupport support(type);
+    if (support.register_type(participant_) != ReturnCode::RETCODE_OK) {
+      throw ClientError(std::string("cannot register DDS type ") + support.get_type_name());
+    }
+    return support.get_type_name();
+  };
+  const auto create_topic = [this](const char* name, const std::string& type_name) {
+    dds::Topic* topic = participant_->create_topic(name, type_name, dds::TOPIC_QOS_DEFAULT);
+    if (topic == nullptr) throw ClientError(std::string("cannot create topic ") + name);
+    return topic;
+  };
+  dds::Topic* request_topic = create_topic(
+      client_detail::kRequestTopic, register_type(std::make_unique<msg::PullOutRequestPubSubType>().release()));
+  dds::Topic* progress_topic = create_topic(
+      client_detail::kProgressTopic, register_type(std::make_unique<msg::ExecutionProgressPubSubType>().release()));
+  dds::Topic* path_topic = create_topic(client_detail::kPathTopic,
+                                        register_type(std::make_unique<msg::PullOutPathPubSubType>().release()));
+  dds::Topic* status_topic = create_topic(
+      client_detail::kStatusTopic, register_type(std::make_unique<msg::PullOutStatusPubSubType>().release()));
+
+  publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (publisher_ == nullptr || subscriber_ == nullptr) throw ClientError("cannot create a DDS publisher/subscriber");
+
+  request_writer_ =
+      publisher_->create_datawriter(request_topic, writer_qos(client_detail::kRequestWriterProfile));
+  if (request_writer_ == nullptr) throw ClientError("cannot create the pullout/request writer");
+  progress_writer_ =
+      publisher_->create_datawriter(progress_topic, writer_qos(client_detail::kProgressWriterProfile));
+  if (progress_writer_ == nullptr) throw ClientError("cannot create the pullout/progress writer");
+  path_reader_ = create_reply_reader(path_topic, client_detail::kPathReaderProfile, kPathReaderDepth);
+  status_reader_ = create_reply_reader(status_topic, client_detail::kStatusReaderProfile, kStatusReaderDepth);
+  path_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available());
+  status_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available());
+}
+
+dds::DataReader* Client::Impl::create_reply_reader(dds::Topic* topic, const char* profile, int depth) {
+  const std::string topic_name = topic->get_name();
+  // The name only has to be unique within this participant (one per client).
+  dds::ContentFilteredTopic* filtered = participant_->create_contentfilteredtopic(
+      topic_name + "/this_vehicle", topic, client_detail::kVehicleFilterExpression,
+      {options_.vehicle_id}, client_detail::kVehicleFilterClass);
+  if (filtered == nullptr) throw ClientError("cannot create the vehicle filter on " + topic_name);
+  dds::DataReader* reader = subscriber_->create_datareader(filtered, reader_qos(profile, depth));
+  if (reader == nullptr) throw ClientError("cannot create the " + topic_name + " reader");
+  return reader;
+}
+
+dds::DataWriterQos Client::Impl::writer_qos(const char* profile) const {
+  dds::DataWriterQos qos = client_detail::command_writer_qos();
+  if (!options_.profiles_file.empty()) {
+    dds::DataWriterQos from_profile;
+    if (publisher_->get_datawriter_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
+      qos = from_profile;
+    }
+  }
+  return qos;
+}
+
+dds::DataReaderQos Client::Impl::reader_qos(const char* profile, int depth) const {
+  dds::DataReaderQos qos = client_detail::reply_reader_qos(depth);
+  if (!options_.profiles_file.empty()) {
+    dds::DataReaderQos from_profile;
+    if (subscriber_->get_datareader_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
+      qos = from_profile;
+    }
+  }
+  return qos;
+}
+
+void Client::Impl::destroy_entities() noexcept {
+  if (participant_ == nullptr) return;
+  // Deletes readers before their content-filtered topics, then the topics.
+  participant_->delete_contained_entities();
+  dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  participant_ = nullptr;
+  publisher_ = nullptr;
+  subscriber_ = nullptr;
+  request_writer_ = progress_writer_ = nullptr;
+  path_reader_ = status_reader_ = nullptr;
+}
+
+// ------------------------------------------------------------------------------------------------
+// Writing
+
+std::uint64_t Client::Impl::send(PullOutRequest request) {
+  std::uint64_t id = 0;
+  std::uint64_t previous = 0;
+  const std::int64_t now = system_now_ns();
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    // Strictly increasing, and above any id a previous run issued before now (clock seeded).
+    id = std::max(last_request_id_ + 1, static_cast<std::uint64_t>(std::max<std::int64_t>(now, 1)));
+    last_request_id_ = id;
+    previous = current_request_id_;
+    // Current before the write, so that a reply racing the write's return is recognised.
+    current_request_id_ = id;
+    sent_any_ = true;
+  }
+  request.vehicle_id = options_.vehicle_id;
+  request.request_id = id;
+  request.stamp_ns = now;
+  msg::PullOutRequest sample = idl::to_msg(request);
+  if (!request_writer_->write(&sample)) {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    if (current_request_id_ == id) current_request_id_ = previous;
+    throw ClientError("cannot write request " + std::to_string(id) +
+                      " (DDS write failed: sample too large for the type or transport, or writer error)");
+  }
+  return id;
+}
+
+void Client::Impl::report_progress(ExecutionProgress progress) {
+  progress.vehicle_id = options_.vehicle_id;
+  if (progress.request_id == 0) {
+    progress.request_id = current_request_id();
+    if (progress.request_id == 0) throw std::logic_error("report_progress: no current request to report on");
+  }
+  if (progress.stamp_ns == 0) progress.stamp_ns = system_now_ns();
+  msg::ExecutionProgress sample = idl::to_msg(progress);
+  if (!progress_writer_->write(&sample)) {
+    throw ClientError("cannot write progress for request " + std::to_string(progress.request_id));
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Callbacks and the client's thread
+
+void Client::Impl::on_path(PathCallback callback) {
+  {
+    // From a callback the dispatcher already holds callback_mutex_.
+    std::unique_lock<std::mutex> lock(callback_mutex_, std::defer_lock);
+    if (!on_dispatcher_thread()) lock.lock();
+    path_callback_ = std::move(callback);
+    path_delivered_seq_ = 0;
+  }
+  wake_dispatcher();  // replays the latest path to the new callback
+}
+
+void Client::Impl::on_status(StatusCallback callback) {
+  {
+    std::unique_lock<std::mutex> lock(callback_mutex_, std::defer_lock);
+    if (!on_dispatcher_thread()) lock.lock();
+    status_callback_ = std::move(callback);
+    status_delivered_seq_ = 0;
+  }
+  wake_dispatcher();
+}
+
+void Client::Impl::run() {
+  dds::WaitSet waitset;
+  waitset.attach_condition(path_reader_->get_statuscondition());
+  waitset.attach_condition(status_reader_->get_statuscondition());
+  waitset.attach_condition(wake_);
+  dds::ConditionSeq active;
+  while (!stop_.load()) {
+    // The timeout only bounds how long a missed wake-up could delay the next round.
+    waitset.wait(active, eprosima::fastrtps::Duration_t(1, 0));
+    wake_.set_trigger_value(false);
+    if (stop_.load()) break;
+    dispatch_once();
+  }
+  waitset.detach_condition(wake_);
+  waitset.detach_condition(status_reader_->get_statuscondition());
+  waitset.detach_condition(path_reader_->get_statuscondition());
+}
+
+std::vector<std::shared_ptr<const PullOutPath>> Client::Impl::take_paths() {
+  std::vector<std::shared_ptr<const PullOutPath>> out;
+  msg::PullOutPath sample;
+  dds::SampleInfo info;
+  while (path_reader_->take_next_sample(&sample, &info) == ReturnCode::RETCODE_OK) {
+    if (!info.valid_data) continue;  // instance disposed / writer gone: nothing to deliver
+    try {
+      auto path = std::make_shared<PullOutPath>(idl::from_msg(sample));
+      // The content filter already dropped other vehicles; this covers encodings it passes.
+      if (path->vehicle_id == options_.vehicle_id) out.push_back(std::move(path));
+    } catch (const std::exception& e) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "dropped a path sample that could not be converted: " << e.what());
+    }
+  }
+  return out;
+}
+
+std::vector<std::shared_ptr<const PullOutStatus>> Client::Impl::take_statuses() {
+  std::vector<std::shared_ptr<const PullOutStatus>> out;
+  msg::PullOutStatus sample;
+  dds::SampleInfo info;
+  while (status_reader_->take_next_sample(&sample, &info) == ReturnCode::RETCODE_OK) {
+    if (!info.valid_data) continue;
+    try {
+      auto status = std::make_shared<PullOutStatus>(idl::from_msg(sample));
+      if (status->vehicle_id == options_.vehicle_id) out.push_back(std::move(status));
+    } catch (const std::exception& e) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "dropped a status sample that could not be converted: " << e.what());
+    }
+  }
+  return out;
+}
+
+void Client::Impl::dispatch_once() {
+  auto paths = take_paths();
+  auto statuses = take_statuses();
+
+  // Held across the state update and the deliveries, so that on_path/on_status (which take it)
+  // see each sample either as already delivered to the old callback or as still to deliver.
+  std::lock_guard<std::mutex> callbacks(callback_mutex_);
+  std::vector<Received<PullOutPath>> path_out;
+  std::vector<Received<PullOutStatus>> status_out;
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    // Replay of the latest sample to a newly registered callback.
+    if (path_callback_ && !recent_paths_.empty() && recent_paths_.back().seq > path_delivered_seq_) {
+      path_out.push_back(recent_paths_.back());
+    }
+    if (status_callback_ && !recent_statuses_.empty() && recent_statuses_.back().seq > status_delivered_seq_) {
+      status_out.push_back(recent_statuses_.back());
+    }
+    for (auto& path : paths) {
+      // Before the first send(), follow the request the service last answered (restart case).
+      if (!sent_any_) current_request_id_ = path->request_id;
+      Received<PullOutPath> item{++path_seq_, std::move(path)};
+      if (path_callback_) path_out.push_back(item);
+      push_bounded(recent_paths_, std::move(item), kRecentPaths);
+    }
+    for (auto& status : statuses) {
+      Received<PullOutStatus> item{++status_seq_, std::move(status)};
+      if (status_callback_) status_out.push_back(item);
+      push_bounded(recent_statuses_, std::move(item), kRecentStatuses);
+    }
+  }
+  if (!paths.empty() || !statuses.empty()) state_cv_.notify_all();
+
+  // Paths first: a status announcing execution refers to a path the callback has seen.
+  for (const auto& item : path_out) {
+    if (!path_callback_ || item.seq <= path_delivered_seq_) continue;
+    path_delivered_seq_ = item.seq;
+    PathCallback callback = path_callback_;  // the callback may replace itself
+    try {
+      callback(*item.value);
+    } catch (const std::exception& e) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the path callback threw: " << e.what());
+    } catch (...) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the path callback threw a non-standard exception");
+    }
+  }
+  for (const auto& item : status_out) {
+    if (!status_callback_ || item.seq <= status_delivered_seq_) continue;
+    status_delivered_seq_ = item.seq;
+    StatusCallback callback = status_callback_;
+    try {
+      callback(*item.value);
+    } catch (const std::exception& e) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the status callback threw: " << e.what());
+    } catch (...) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the status callback threw a non-standard exception");
+    }
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Queries and waits
+
+std::optional<PullOutPath> Client::Impl::wait_for_path(std::uint64_t request_id, Duration timeout) const {
+  const auto deadline = deadline_after(timeout);
+  std::unique_lock<std::mutex> lock(state_mutex_);
+  while (true) {
+    for (auto it = recent_paths_.rbegin(); it != recent_paths_.rend(); ++it) {
+      if (it->value->request_id == request_id) return *it->value;
+    }
+    if (stop_.load() || SteadyClock::now() >= deadline) return std::nullopt;
+    state_cv_.wait_until(lock, deadline);
+  }
+}
+
+std::optional<PullOutStatus> Client::Impl::wait_for_status(std::uint64_t request_id,
+                                                           const StatusPredicate& predicate,
+                                                           Duration timeout) const {
+  const auto deadline = deadline_after(timeout);
+  const auto accepts = [&](const PullOutStatus& s) {
+    return s.request_id == request_id && (!predicate || predicate(s));
+  };
+  std::unique_lock<std::mutex> lock(state_mutex_);
+  // The latest status already received for this request.
+  for (auto it = recent_statuses_.rbegin(); it != recent_statuses_.rend(); ++it) {
+    if (it->value->request_id != request_id) continue;
+    if (accepts(*it->value)) return *it->value;
+    break;
+  }
+  std::uint64_t seen = status_seq_;
+  while (true) {
+    if (stop_.load() || SteadyClock::now() >= deadline) return std::nullopt;
+    state_cv_.wait_until(lock, deadline);
+    for (const auto& item : recent_statuses_) {
+      if (item.seq > seen && accepts(*item.value)) return *item.value;
+    }
+    seen = status_seq_;
+  }
+}
+
+std::optional<PullOutPath> Client::Impl::latest_path() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (recent_paths_.empty()) return std::nullopt;
+  return *recent_paths_.back().value;
+}
+
+std::optional<PullOutStatus> Client::Impl::latest_status() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (recent_statuses_.empty()) return std::nullopt;
+  return *recent_statuses_.back().value;
+}
+
+std::uint64_t Client::Impl::current_request_id() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  return current_request_id_;
+}
+
+std::optional<std::uint32_t> Client::Impl::current_segment() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  if (current_request_id_ == 0) return std::nullopt;
+  for (auto it = recent_statuses_.rbegin(); it != recent_statuses_.rend(); ++it) {
+    const PullOutStatus& status = *it->value;
+    if (status.request_id != current_request_id_) continue;
+    if (status.state == ExecutionState::kExecuting || status.state == ExecutionState::kCompleted) {
+      return status.current_path_idx;
+    }
+    return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+bool Client::Impl::wait_for_service(Duration timeout) const {
+  const auto deadline = deadline_after(timeout);
+  while (true) {
+    dds::PublicationMatchedStatus request_matched;
+    dds::SubscriptionMatchedStatus path_matched;
+    dds::SubscriptionMatchedStatus status_matched;
+    request_writer_->get_publication_matched_status(request_matched);
+    path_reader_->get_subscription_matched_status(path_matched);
+    status_reader_->get_subscription_matched_status(status_matched);
+    if (request_matched.current_count > 0 && path_matched.current_count > 0 && status_matched.current_count > 0) {
+      return true;
+    }
+    const auto now = SteadyClock::now();
+    if (now >= deadline) return false;
+    std::this_thread::sleep_for(std::min<SteadyClock::duration>(kMatchPollPeriod, deadline - now));
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Client: forwards to Impl
+
+Client::Client(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Client::~Client() = default;
+
+std::uint64_t Client::send(PullOutRequest request) { return impl_->send(std::move(request)); }
+void Client::report_progress(ExecutionProgress progress) { impl_->report_progress(std::move(progress)); }
+void Client::on_path(PathCallback callback) { impl_->on_path(std::move(callback)); }
+void Client::on_status(StatusCallback callback) { impl_->on_status(std::move(callback)); }
+std::optional<PullOutPath> Client::wait_for_path(std::uint64_t request_id, Duration timeout) const {
+  return impl_->wait_for_path(request_id, timeout);
+}
+std::optional<PullOutStatus> Client::wait_for_status(std::uint64_t request_id, const StatusPredicate& predicate,
+                                                     Duration timeout) const {
+  return impl_->wait_for_status(request_id, predicate, timeout);
+}
+std::optional<PullOutPath> Client::latest_path() const { return impl_->latest_path(); }
+std::optional<PullOutStatus> Client::latest_status() const { return impl_->latest_status(); }
+std::uint64_t Client::current_request_id() const { return impl_->current_request_id(); }
+std::optional<std::uint32_t> Client::current_segment() const { return impl_->current_segment(); }
+bool Client::wait_for_service(Duration timeout) const { return impl_->wait_for_service(timeout); }
+const std::string& Client::vehicle_id() const { return impl_->options().vehicle_id; }
+int Client::domain_id() const { return impl_->options().domain_id; }
+
+}  // namespace pullout

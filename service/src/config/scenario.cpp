@@ -1,0 +1,247 @@
+// Loading of scenario files (see scenario.hpp for the format).
+#include "pullout/config/scenario.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <utility>
+
+#include <yaml-cpp/yaml.h>
+
+#include "config/config_detail.hpp"
+#include "config/yaml_fields.hpp"
+#include "pullout/model/names.hpp"
+
+namespace pullout {
+namespace {
+
+using yaml_fields::MapReader;
+using yaml_fields::Problems;
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+// Scenario requests carry a fixed id: a client sending one assigns its own.
+constexpr std::uint64_t kScenarioRequestId = 1;
+
+std::optional<Point2> read_point(const YAML::Node& node, const std::string& path, Problems& problems) {
+  if (!node.IsSequence() || node.size() != 2) {
+    problems.push_back(path + ": expected [x, y]" + yaml_fields::where(node));
+    return std::nullopt;
+  }
+  const auto x = yaml_fields::to_double(node[0], path + ".x", problems);
+  const auto y = yaml_fields::to_double(node[1], path + ".y", problems);
+  if (!x || !y) return std::nullopt;
+  return Point2{*x, *y};
+}
+
+// A list of [x, y] points. `min_points` > 0 also checks the count.
+std::vector<Point2> read_points(MapReader& r, const std::string& key, std::size_t min_points) {
+  std::vector<Point2> points;
+  const YAML::Node n = r.get(key);
+  const std::string path = r.key_path(key);
+  if (!n.IsDefined()) {
+    if (min_points > 0) r.problems().push_back(path + ": required");
+    return points;
+  }
+  if (!n.IsSequence()) {
+    r.problems().push_back(path + ": expected a list of [x, y] points" + yaml_fields::where(n));
+    return points;
+  }
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    if (auto p = read_point(n[i], yaml_fields::indexed(path, i), r.problems())) points.push_back(*p);
+  }
+  if (n.size() < min_points) {
+    r.problems().push_back(path + ": needs at least " + std::to_string(min_points) + " points, got " +
+                           std::to_string(n.size()) + yaml_fields::where(n));
+  }
+  return points;
+}
+
+// yaw [rad] or yaw_deg; neither means 0.
+double read_yaw(MapReader& r) {
+  double yaw = 0.0;
+  double yaw_deg = 0.0;
+  const bool has_rad = r.read("yaw", yaw);
+  const bool has_deg = r.read("yaw_deg", yaw_deg);
+  if (r.has("yaw") && r.has("yaw_deg")) {
+    r.problems().push_back(r.key_path("yaw_deg") + ": give either yaw [rad] or yaw_deg, not both");
+  }
+  if (has_deg) return yaw_deg * kDegToRad;
+  return has_rad ? yaw : 0.0;
+}
+
+// {x, y, yaw | yaw_deg}
+Pose2 read_pose(MapReader& parent, const std::string& key, bool required) {
+  Pose2 pose;
+  if (!parent.has(key)) {
+    parent.get(key);
+    if (required) parent.problems().push_back(parent.key_path(key) + ": required ({x, y, yaw_deg})");
+    return pose;
+  }
+  MapReader r(parent.get(key), parent.key_path(key), parent.problems());
+  if (!r.valid()) return pose;
+  if (!r.read("x", pose.x) && !r.has("x")) r.problems().push_back(r.key_path("x") + ": required");
+  if (!r.read("y", pose.y) && !r.has("y")) r.problems().push_back(r.key_path("y") + ": required");
+  pose.yaw = read_yaw(r);
+  r.finish();
+  return pose;
+}
+
+Lane read_lane(const YAML::Node& node, const std::string& path, Problems& problems) {
+  Lane lane;
+  MapReader r(node, path, problems);
+  if (!r.valid()) return lane;
+  if (!r.read("id", lane.id) && !r.has("id")) problems.push_back(r.key_path("id") + ": required");
+  std::string subtype;
+  if (r.read("subtype", subtype)) {
+    if (const auto s = lane_subtype_from_string(subtype)) {
+      lane.subtype = *s;
+    } else {
+      problems.push_back(r.key_path("subtype") + ": unknown subtype '" + subtype +
+                         "' (expected road or road_shoulder)" + yaml_fields::where(r.get("subtype")));
+    }
+  }
+  r.read("speed_limit", lane.speed_limit_mps);
+  lane.left_bound = read_points(r, "left_bound", 2);
+  lane.right_bound = read_points(r, "right_bound", 2);
+  lane.centerline = read_points(r, "centerline", 0);
+  if (r.has("centerline") && !lane.centerline.empty() && lane.centerline.size() < 2) {
+    problems.push_back(r.key_path("centerline") + ": needs at least 2 points when given");
+  }
+  r.finish();
+  return lane;
+}
+
+Object read_object(const YAML::Node& node, const std::string& path, std::size_t index, Problems& problems) {
+  Object object;
+  object.id = static_cast<std::int64_t>(index);  // default: the position in the list
+  MapReader r(node, path, problems);
+  if (!r.valid()) return object;
+  r.read("id", object.id);
+  std::string name;
+  if (r.read("class", name)) {
+    if (const auto c = object_class_from_string(name)) {
+      object.object_class = *c;
+    } else {
+      problems.push_back(r.key_path("class") + ": unknown class '" + name +
+                         "' (expected unknown, car, truck, bus, trailer, motorcycle, bicycle or pedestrian)" +
+                         yaml_fields::where(r.get("class")));
+    }
+  }
+  if (!r.read("x", object.pose.x) && !r.has("x")) problems.push_back(r.key_path("x") + ": required");
+  if (!r.read("y", object.pose.y) && !r.has("y")) problems.push_back(r.key_path("y") + ": required");
+  object.pose.yaw = read_yaw(r);
+  if (r.read("length", object.length_m) && !(object.length_m > 0.0)) {
+    problems.push_back(r.key_path("length") + ": must be > 0");
+  }
+  if (r.read("width", object.width_m) && !(object.width_m > 0.0)) {
+    problems.push_back(r.key_path("width") + ": must be > 0");
+  }
+  r.read("velocity", object.velocity_mps);
+  object.polygon = read_points(r, "polygon", 0);
+  if (r.has("polygon") && object.polygon.size() < 3) {
+    problems.push_back(r.key_path("polygon") + ": needs at least 3 points when given");
+  }
+  r.finish();
+  return object;
+}
+
+template <typename Item, typename ReadItem>
+std::vector<Item> read_list(MapReader& r, const std::string& key, ReadItem read_item) {
+  std::vector<Item> items;
+  const YAML::Node n = r.get(key);
+  if (!n.IsDefined() || n.IsNull()) return items;
+  const std::string path = r.key_path(key);
+  if (!n.IsSequence()) {
+    r.problems().push_back(path + ": expected a list" + yaml_fields::where(n));
+    return items;
+  }
+  for (std::size_t i = 0; i < n.size(); ++i) items.push_back(read_item(n[i], yaml_fields::indexed(path, i), i));
+  return items;
+}
+
+void read_expectation(MapReader& parent, ScenarioExpectation& out) {
+  MapReader r(parent.get("expect"), "expect", parent.problems());
+  if (!r.valid()) return;
+  bool found = false;
+  if (r.read("found", found)) out.found = found;
+  std::string planner;
+  if (r.read("planner", planner)) {
+    if (const auto p = parse_planner_name(planner)) {
+      out.planner = *p;
+    } else {
+      r.problems().push_back(r.key_path("planner") + ": unknown planner '" + planner + "'" +
+                             yaml_fields::where(r.get("planner")));
+    }
+  }
+  double margin = 0.0;
+  if (r.read("margin", margin)) out.margin_m = margin;
+  r.finish();
+}
+
+// The request-level overrides a scenario's `planner:` section implies, so that a scenario sent to
+// a running service (which has its own parameters) searches the same planners in the same way.
+void set_overrides(const YAML::Node& planner, const StartPlannerParameters& params, PlannerOverrides& out) {
+  if (!planner.IsMap()) return;
+  if (planner["search_priority"].IsDefined()) out.search_priority = params.search_priority;
+  if (planner["search_policy"].IsDefined()) out.search_policy = params.search_policy;
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::string& path, const Config& base) {
+  const YAML::Node doc = load_yaml_file(path);
+  Scenario s;
+  s.path = path;
+  s.vehicle = base.vehicle;
+  s.parameters = base.start_planner;
+  Problems problems;
+  MapReader root(doc, "", problems);
+  if (!root.valid()) throw ConfigError(path, std::move(problems));
+
+  root.read("description", s.description);
+  PullOutRequest& request = s.request;
+  request.vehicle_id = std::filesystem::path(path).stem().string();
+  root.read("vehicle_id", request.vehicle_id);
+  if (request.vehicle_id.empty()) problems.push_back("vehicle_id: must not be empty");
+  request.request_id = kScenarioRequestId;
+
+  if (root.has("vehicle")) {
+    apply_vehicle_info(root.get("vehicle"), "vehicle", s.vehicle, problems);
+    append_parameter_issues(validate_vehicle(s.vehicle), "vehicle", problems);
+  }
+  if (root.has("map")) {
+    root.get("map");
+    problems.push_back("map: lanelet2 maps are not supported yet: give the lanes inline (lanes:)");
+  }
+  if (root.has("route")) {
+    root.get("route");
+    problems.push_back("route: routes on a lanelet2 map are not supported yet: give the lanes inline (lanes:)");
+  }
+
+  request.lanes = read_list<Lane>(root, "lanes", [&](const YAML::Node& n, const std::string& p, std::size_t) {
+    return read_lane(n, p, problems);
+  });
+  if (!root.has("lanes") && !root.has("map")) problems.push_back("lanes: required (the inline lanes)");
+
+  request.ego_pose = read_pose(root, "start", true);
+  root.read("start_velocity", request.ego_velocity_mps);
+  request.goal_pose = read_pose(root, "goal", true);
+  request.objects = read_list<Object>(root, "objects", [&](const YAML::Node& n, const std::string& p,
+                                                           std::size_t i) { return read_object(n, p, i, problems); });
+
+  if (root.has("planner")) {
+    const YAML::Node planner = root.get("planner");
+    apply_start_planner_parameters(planner, "planner", s.parameters, problems);
+    append_parameter_issues(validate_parameters(s.parameters), "planner", problems);
+    set_overrides(planner, s.parameters, request.overrides);
+  }
+  if (root.read("deadline_ms", request.deadline_ms) && request.deadline_ms < 0.0) {
+    problems.push_back("deadline_ms: must be >= 0 (0 = the default)");
+  }
+  if (root.has("expect")) read_expectation(root, s.expect);
+  root.finish();
+
+  if (!problems.empty()) throw ConfigError(path, std::move(problems));
+  return s;
+}
+
+}  // namespace pullout

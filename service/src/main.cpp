@@ -1,0 +1,113 @@
+// pullout_service: the start planner as a Fast DDS microservice.
+//
+//   pullout_service --config config/pullout.yaml [--domain N] [--log-level L]
+//
+// Exit codes: 0 after SIGINT/SIGTERM, 1 bad command line or config, 2 DDS setup failed, 3 any
+// other start-up failure. Everything is built inside one try block; a failure prints one line per
+// problem and exits.
+#include <pthread.h>
+#include <signal.h>
+#include <cstdio>
+#include <ctime>
+#include <exception>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "pullout/config/config.hpp"
+#include "pullout/model/names.hpp"
+#include "service/pullout_service.hpp"
+
+namespace {
+
+constexpr int kExitUsage = 1;
+constexpr int kExitConfig = 1;
+constexpr int kExitDds = 2;
+constexpr int kExitOther = 3;
+
+// Blocks SIGINT and SIGTERM in the calling thread and, because the mask is inherited, in every
+// thread created afterwards (Fast DDS's and ours). They are then received only by sigtimedwait()
+// in main, where stopping the service is an ordinary function call instead of work inside a
+// signal handler.
+sigset_t block_stop_signals() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  return set;
+}
+
+// Waits for SIGINT or SIGTERM; returns its name.
+const char* wait_for_stop_signal(const sigset_t& set) {
+  const timespec poll_period{1, 0};
+  while (true) {
+    const int sig = sigtimedwait(&set, nullptr, &poll_period);
+    if (sig == SIGINT) return "SIGINT";
+    if (sig == SIGTERM) return "SIGTERM";
+    // -1: timeout or EINTR (another signal): keep waiting.
+  }
+}
+
+void setup_logging() {
+  auto logger = spdlog::stderr_color_mt("pullout_service");
+  logger->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] %v");
+  spdlog::set_default_logger(logger);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"pullout_service: start (pull-out) planner for automated vehicles, over Fast DDS"};
+  std::string config_path;
+  int domain_id = -1;
+  std::string log_level;
+  app.add_option("-c,--config", config_path, "config file (e.g. config/pullout.yaml)")->required();
+  app.add_option("--domain", domain_id, "DDS domain id, overrides dds.domain_id")->check(CLI::Range(0, 232));
+  app.add_option("--log-level", log_level, "overrides service.log_level")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : kExitUsage;
+  }
+
+  const sigset_t stop_signals = block_stop_signals();
+  setup_logging();
+
+  pullout::Config config;
+  try {
+    config = pullout::load_config(config_path);
+  } catch (const pullout::ConfigError& e) {
+    // One line per problem, already "<file>: <key>: <problem>".
+    std::fprintf(stderr, "pullout_service: invalid config:\n%s\n", e.what());
+    return kExitConfig;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pullout_service: %s: %s\n", config_path.c_str(), e.what());
+    return kExitConfig;
+  }
+  if (domain_id >= 0) config.dds.domain_id = domain_id;
+  if (!log_level.empty()) config.service.log_level = log_level;
+  spdlog::set_level(spdlog::level::from_str(config.service.log_level));
+
+  try {
+    pullout::service::PulloutService service(config);
+    service.start();
+    spdlog::info("pullout_service ready: domain {}, participant profile '{}' from {}, {} planning thread(s)",
+                 config.dds.domain_id, config.dds.participant_profile, config.dds.profiles_file,
+                 config.service.worker_threads);
+    const char* signal_name = wait_for_stop_signal(stop_signals);
+    spdlog::info("{} received, stopping", signal_name);
+    service.stop();
+  } catch (const pullout::service::DdsSetupError& e) {
+    spdlog::critical("DDS setup failed: {}", e.what());
+    return kExitDds;
+  } catch (const std::exception& e) {
+    spdlog::critical("start-up failed: {}", e.what());
+    return kExitOther;
+  }
+  spdlog::info("pullout_service stopped");
+  return 0;
+}

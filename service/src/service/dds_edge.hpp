@@ -1,0 +1,84 @@
+// The service's DDS entities: one participant, the four pullout topics, readers for requests and
+// progress, writers for paths and statuses. QoS comes from the XML profiles file named in the
+// config (config/dds/*.xml), by profile name:
+//
+//   participant  <dds.participant_profile>
+//   readers      pullout_request_reader, pullout_progress_reader
+//   writers      pullout_path_writer, pullout_status_writer
+//
+// Construction loads the XML and creates everything, or throws DdsSetupError naming the step that
+// failed (after deleting whatever was created). Destruction deletes every entity and the
+// participant, which also removes the participant's shared-memory files.
+#pragma once
+
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "pullout/config/config.hpp"
+#include "service/outbox.hpp"
+
+namespace eprosima::fastdds::dds {
+class DomainParticipant;
+class Publisher;
+class Subscriber;
+class Topic;
+class DataReader;
+class DataWriter;
+}  // namespace eprosima::fastdds::dds
+
+namespace pullout::service {
+
+class DdsSetupError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+inline constexpr const char* kRequestTopic = "pullout/request";
+inline constexpr const char* kPathTopic = "pullout/path";
+inline constexpr const char* kStatusTopic = "pullout/status";
+inline constexpr const char* kProgressTopic = "pullout/progress";
+
+inline constexpr const char* kRequestReaderProfile = "pullout_request_reader";
+inline constexpr const char* kProgressReaderProfile = "pullout_progress_reader";
+inline constexpr const char* kPathWriterProfile = "pullout_path_writer";
+inline constexpr const char* kStatusWriterProfile = "pullout_status_writer";
+
+class DdsEdge final : public Outbox {
+ public:
+  // `config.profiles_file` must name a readable Fast DDS XML file (load_config resolves it).
+  explicit DdsEdge(const DdsConfig& config);
+  ~DdsEdge() override;
+  DdsEdge(const DdsEdge&) = delete;
+  DdsEdge& operator=(const DdsEdge&) = delete;
+
+  bool publish_path(const PullOutPath& path) override;
+  bool publish_status(const PullOutStatus& status) override;
+
+  // For the dispatcher thread only (take samples, wait on their status conditions).
+  eprosima::fastdds::dds::DataReader& request_reader() { return *request_reader_; }
+  eprosima::fastdds::dds::DataReader& progress_reader() { return *progress_reader_; }
+
+ private:
+  void create_entities(const DdsConfig& config);
+  void check_qos() const;
+  void destroy() noexcept;
+
+  eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
+  eprosima::fastdds::dds::Publisher* publisher_{nullptr};
+  eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};
+  eprosima::fastdds::dds::Topic* request_topic_{nullptr};
+  eprosima::fastdds::dds::Topic* path_topic_{nullptr};
+  eprosima::fastdds::dds::Topic* status_topic_{nullptr};
+  eprosima::fastdds::dds::Topic* progress_topic_{nullptr};
+  eprosima::fastdds::dds::DataReader* request_reader_{nullptr};
+  eprosima::fastdds::dds::DataReader* progress_reader_{nullptr};
+  eprosima::fastdds::dds::DataWriter* path_writer_{nullptr};
+  eprosima::fastdds::dds::DataWriter* status_writer_{nullptr};
+  // The generated type support keeps per-type scratch buffers (key serialisation), so writes of
+  // one type from several threads are serialised here.
+  std::mutex path_mutex_;
+  std::mutex status_mutex_;
+};
+
+}  // namespace pullout::service

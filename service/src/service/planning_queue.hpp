@@ -1,0 +1,70 @@
+// A pool of planning threads fed with per-vehicle jobs.
+//
+// At most one job per vehicle runs at a time and at most one waits: a newer job of the same
+// vehicle replaces the waiting one (only the latest request of a vehicle matters). Vehicles are
+// served in the order their jobs became ready, so one busy vehicle cannot starve the others.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "pullout/model/types.hpp"
+
+namespace pullout::service {
+
+struct PlanningJob {
+  PullOutRequest request;
+  // The vehicle's acceptance number (VehicleRegistry): a result is published only if no newer
+  // request of the vehicle was accepted meanwhile.
+  std::uint64_t sequence{0};
+  // Set when a newer request of the vehicle arrives or the service stops; the search's Deadline
+  // watches it.
+  std::shared_ptr<std::atomic<bool>> cancel;
+  std::chrono::steady_clock::time_point accepted_at;
+};
+
+class PlanningQueue {
+ public:
+  // Runs one job on a worker thread. Must not throw (exceptions are caught and logged anyway).
+  using Runner = std::function<void(PlanningJob&)>;
+
+  PlanningQueue(int worker_threads, Runner runner);
+  ~PlanningQueue();
+  PlanningQueue(const PlanningQueue&) = delete;
+  PlanningQueue& operator=(const PlanningQueue&) = delete;
+
+  // Queues a job for its vehicle. Returns true when it replaced a job of that vehicle that had not
+  // started yet. Ignored after stop().
+  bool push(PlanningJob job);
+
+  // Drops the waiting jobs and joins the workers once their running jobs return (cancel those
+  // first to make this quick). Idempotent.
+  void stop();
+
+  std::size_t waiting() const;
+
+ private:
+  void worker_loop();
+
+  Runner runner_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::unordered_map<std::string, PlanningJob> waiting_;  // vehicle -> its next job
+  std::deque<std::string> ready_;                         // vehicles with a waiting job and none running
+  std::unordered_set<std::string> running_;
+  bool stopping_{false};
+  std::vector<std::thread> workers_;
+};
+
+}  // namespace pullout::service

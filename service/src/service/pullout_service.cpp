@@ -1,0 +1,208 @@
+#include "service/pullout_service.hpp"
+
+#include <algorithm>
+#include <exception>
+#include <utility>
+#include <vector>
+
+#include <fastdds/dds/core/condition/StatusCondition.hpp>
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <spdlog/spdlog.h>
+
+#include "pullout/idl/convert.hpp"
+#include "pullout/model/names.hpp"
+
+namespace pullout::service {
+namespace dds = eprosima::fastdds::dds;
+
+namespace {
+
+// The dispatcher also wakes this often without any event, so that a missed wake-up (which should
+// not happen) costs at most this much latency rather than a stuck vehicle.
+const eprosima::fastrtps::Duration_t kDispatcherWakePeriod{1, 0};
+constexpr auto kProgressWarnInterval = std::chrono::seconds(5);
+// Must match the generated key buffer (see convert.cpp): replies to a longer id cannot be written.
+constexpr std::size_t kMaxVehicleIdBytes = 255;
+
+const char* outcome_name(PlanningResult::Outcome o) {
+  switch (o) {
+    case PlanningResult::Outcome::kFound:
+      return "found";
+    case PlanningResult::Outcome::kNoPath:
+      return "no path";
+    case PlanningResult::Outcome::kRejected:
+      return "rejected";
+  }
+  return "?";
+}
+
+}  // namespace
+
+PulloutService::PulloutService(const Config& config)
+    : config_(config),
+      dds_(config.dds),
+      planner_(config.vehicle, config.start_planner, config.service.limits),
+      registry_(config.start_planner, dds_) {
+  queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
+}
+
+PulloutService::~PulloutService() { stop(); }
+
+void PulloutService::start() {
+  if (dispatcher_.joinable() || stopping_) return;
+  dispatcher_ = std::thread([this] { dispatch_loop(); });
+}
+
+void PulloutService::stop() {
+  if (stopping_.exchange(true)) {
+    // Another caller is stopping (or has stopped): wait for the dispatcher like it does.
+    if (dispatcher_.joinable() && dispatcher_.get_id() != std::this_thread::get_id()) dispatcher_.join();
+    return;
+  }
+  shutdown_.set_trigger_value(true);
+  if (dispatcher_.joinable()) dispatcher_.join();
+  registry_.cancel_all();
+  if (queue_) queue_->stop();
+}
+
+double PulloutService::effective_deadline_ms(double requested_ms) const {
+  const double budget = requested_ms > 0.0 ? requested_ms : config_.service.default_deadline_ms;
+  return std::min(budget, config_.service.limits.max_deadline_ms);
+}
+
+void PulloutService::dispatch_loop() {
+  dds::WaitSet waitset;
+  dds::StatusCondition& requests = dds_.request_reader().get_statuscondition();
+  dds::StatusCondition& progress = dds_.progress_reader().get_statuscondition();
+  requests.set_enabled_statuses(dds::StatusMask::data_available());
+  progress.set_enabled_statuses(dds::StatusMask::data_available());
+  waitset.attach_condition(requests);
+  waitset.attach_condition(progress);
+  waitset.attach_condition(shutdown_);
+  spdlog::debug("dispatcher running");
+
+  while (!stopping_) {
+    dds::ConditionSeq active;
+    const auto rc = waitset.wait(active, kDispatcherWakePeriod);
+    if (stopping_) break;
+    if (rc != dds::ReturnCode_t::RETCODE_OK && rc != dds::ReturnCode_t::RETCODE_TIMEOUT) {
+      spdlog::error("dispatcher: WaitSet::wait failed (code {})", rc());
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    // Both readers are drained on every wake-up: cheap when empty, and it cannot miss data.
+    take_requests();
+    take_progress();
+  }
+
+  // The conditions belong to the readers, which outlive this thread; detach before they go.
+  waitset.detach_condition(requests);
+  waitset.detach_condition(progress);
+  waitset.detach_condition(shutdown_);
+  spdlog::debug("dispatcher stopped");
+}
+
+void PulloutService::take_requests() {
+  msg::PullOutRequest sample;
+  dds::SampleInfo info;
+  dds::DataReader& reader = dds_.request_reader();
+  while (!stopping_) {
+    try {
+      if (reader.take_next_sample(&sample, &info) != dds::ReturnCode_t::RETCODE_OK) return;
+      if (info.valid_data) handle_request(sample);
+    } catch (const std::exception& e) {
+      // One bad sample (say an allocation failure on a huge one) must not take the service down.
+      spdlog::error("request dropped: {}", e.what());
+    }
+  }
+}
+
+void PulloutService::take_progress() {
+  msg::ExecutionProgress sample;
+  dds::SampleInfo info;
+  dds::DataReader& reader = dds_.progress_reader();
+  while (!stopping_) {
+    try {
+      if (reader.take_next_sample(&sample, &info) != dds::ReturnCode_t::RETCODE_OK) return;
+      if (info.valid_data) handle_progress(sample);
+    } catch (const std::exception& e) {
+      spdlog::error("progress sample dropped: {}", e.what());
+    }
+  }
+}
+
+void PulloutService::handle_request(const msg::PullOutRequest& sample) {
+  if (sample.vehicle_id().size() > kMaxVehicleIdBytes) {
+    spdlog::warn("request {} dropped: vehicle_id of {} bytes cannot be answered (at most {})", sample.request_id(),
+                 sample.vehicle_id().size(), kMaxVehicleIdBytes);
+    return;
+  }
+  std::vector<RequestIssue> issues;
+  PullOutRequest request = idl::from_msg(sample, issues);
+  if (!issues.empty()) {
+    spdlog::warn("vehicle '{}' request {} rejected: {} problem(s), first: {}: {}", request.vehicle_id,
+                 request.request_id, issues.size(), issues.front().field, issues.front().problem);
+    registry_.reject(request.vehicle_id, request.request_id, issues);
+    return;
+  }
+  spdlog::info("vehicle '{}' request {}: accepted ({} lanes, {} objects)", request.vehicle_id, request.request_id,
+               request.lanes.size(), request.objects.size());
+  PlanningJob job = registry_.accept(std::move(request));
+  const std::string vehicle = job.request.vehicle_id;
+  if (queue_->push(std::move(job))) {
+    spdlog::debug("vehicle '{}': a waiting request was replaced by a newer one", vehicle);
+  }
+}
+
+void PulloutService::handle_progress(const msg::ExecutionProgress& sample) {
+  std::vector<RequestIssue> issues;
+  ExecutionProgress progress = idl::from_msg(sample, issues);
+  if (!issues.empty()) {
+    const auto now = std::chrono::steady_clock::now();
+    auto [it, first] = progress_warned_.try_emplace(progress.vehicle_id, now);
+    if (first || now - it->second >= kProgressWarnInterval) {
+      it->second = now;
+      spdlog::warn("vehicle '{}' progress ignored: {}: {}", progress.vehicle_id, issues.front().field,
+                   issues.front().problem);
+    }
+    return;
+  }
+  registry_.on_progress(progress);
+}
+
+void PulloutService::run_job(PlanningJob& job) {
+  const PullOutRequest& request = job.request;
+  if (stopping_ || job.cancel->load()) return;  // superseded or shutting down before it started
+  const double budget_ms = effective_deadline_ms(request.deadline_ms);
+  const Deadline deadline = Deadline::after_ms(budget_ms, job.cancel.get());
+  const double waited_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - job.accepted_at).count();
+
+  PlanningResult result;
+  try {
+    result = planner_.plan(request, deadline);
+  } catch (const std::exception& e) {
+    spdlog::error("vehicle '{}' request {}: planner failed: {}", request.vehicle_id, request.request_id, e.what());
+    if (!stopping_) registry_.fail(job, e.what());
+    return;
+  }
+  if (stopping_) return;  // a search cut short by shutdown is not a "no path"
+  if (!registry_.complete(job, result)) {
+    spdlog::debug("vehicle '{}' request {}: result dropped, a newer request arrived", request.vehicle_id,
+                  request.request_id);
+    return;
+  }
+  if (result.outcome == PlanningResult::Outcome::kFound) {
+    spdlog::info("vehicle '{}' request {}: {} path, {} segment(s), {:.1f} ms (+{:.1f} ms queued)", request.vehicle_id,
+                 request.request_id, to_string(result.path.planner_type), result.path.partial_paths.size(),
+                 result.planning_time_ms, waited_ms);
+  } else {
+    spdlog::info("vehicle '{}' request {}: {}{}, {:.1f} ms: {}", request.vehicle_id, request.request_id,
+                 outcome_name(result.outcome), result.timed_out ? " (deadline)" : "", result.planning_time_ms,
+                 result.outcome == PlanningResult::Outcome::kRejected ? format_issues(result.issues)
+                                                                      : result.stop_reason);
+  }
+}
+
+}  // namespace pullout::service

@@ -1,0 +1,76 @@
+// The pullout service: DDS in and out, a dispatcher thread and a pool of planning threads.
+//
+//   DDS readers --(WaitSet: DATA_AVAILABLE / shutdown guard)--> dispatcher thread
+//     request  -> convert + check -> kRejected, or kPlanning + per-vehicle job -> planning workers
+//     progress -> convert + check -> the vehicle's execution tracker -> status on change
+//   planning worker -> StartPlanner::plan(request, deadline) -> path + status
+//
+// Nothing is planned inside DDS callbacks (there are none: no listeners). The deadline of a search
+// is the request's deadline_ms, or service.default_deadline_ms when it gives none, capped by
+// service.limits.max_deadline_ms; it is also cancelled when a newer request of the same vehicle
+// arrives or the service stops.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+#include <unordered_map>
+
+#include <fastdds/dds/core/condition/GuardCondition.hpp>
+
+#include "pullout/config/config.hpp"
+#include "pullout/pipeline/start_planner.hpp"
+#include "service/dds_edge.hpp"
+#include "service/planning_queue.hpp"
+#include "service/vehicle_registry.hpp"
+
+namespace pullout::msg {
+class PullOutRequest;
+class ExecutionProgress;
+}  // namespace pullout::msg
+
+namespace pullout::service {
+
+class PulloutService {
+ public:
+  // Creates the DDS entities (throws DdsSetupError) and the planning threads. `config` must be
+  // valid (load_config validates it).
+  explicit PulloutService(const Config& config);
+  ~PulloutService();
+  PulloutService(const PulloutService&) = delete;
+  PulloutService& operator=(const PulloutService&) = delete;
+
+  // Starts the dispatcher thread.
+  void start();
+  // Stops taking samples, cancels the searches and joins every thread; the DDS entities are deleted
+  // with the object. Thread-safe and idempotent (not async-signal-safe: call it from a thread).
+  void stop();
+
+  // The planning budget for a request's deadline_ms [ms].
+  double effective_deadline_ms(double requested_ms) const;
+
+ private:
+  void dispatch_loop();
+  void take_requests();
+  void take_progress();
+  void handle_request(const msg::PullOutRequest& sample);
+  void handle_progress(const msg::ExecutionProgress& sample);
+  void run_job(PlanningJob& job);
+
+  Config config_;
+  DdsEdge dds_;
+  StartPlanner planner_;
+  VehicleRegistry registry_;
+  std::atomic<bool> stopping_{false};
+  eprosima::fastdds::dds::GuardCondition shutdown_;
+  std::thread dispatcher_;
+  // Dispatcher thread only: when each vehicle last had a malformed progress sample logged, so that
+  // a sender stuck at 50 Hz does not flood the log.
+  std::unordered_map<std::string, std::chrono::steady_clock::time_point> progress_warned_;
+  // Last: destroyed (workers joined) before the registry and the DDS entities they use.
+  std::unique_ptr<PlanningQueue> queue_;
+};
+
+}  // namespace pullout::service

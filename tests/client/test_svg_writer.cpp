@@ -1,0 +1,242 @@
+// The CLI's SVG writer: well-formed XML, one element per lane/object/segment, footprints from the
+// vehicle dimensions, y pointing up, a viewBox that holds everything, a legend and a scale bar.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <tinyxml2.h>
+
+#include "svg_writer.hpp"
+
+namespace pullout::cli {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+PullOutRequest scene() {
+  PullOutRequest request;
+  Lane road;
+  road.id = 1;
+  road.subtype = LaneSubtype::kRoad;
+  road.left_bound = {{0.0, 1.75}, {60.0, 1.75}};
+  road.right_bound = {{0.0, -1.75}, {60.0, -1.75}};
+  road.centerline = {{0.0, 0.0}, {60.0, 0.0}};
+  Lane shoulder;
+  shoulder.id = 2;
+  shoulder.subtype = LaneSubtype::kRoadShoulder;
+  shoulder.left_bound = {{0.0, 4.75}, {60.0, 4.75}};
+  shoulder.right_bound = {{0.0, 1.75}, {60.0, 1.75}};
+  request.lanes = {road, shoulder};
+  Object car;
+  car.id = 7;
+  car.object_class = ObjectClass::kCar;
+  car.pose = {20.0, 3.25, 0.0};
+  Object triangle;
+  triangle.id = 8;
+  triangle.pose = {40.0, -1.0, 0.0};
+  triangle.polygon = {{1.0, 0.0}, {-1.0, 1.0}, {-1.0, -1.0}};
+  request.objects = {car, triangle};
+  request.ego_pose = {10.0, 3.25, 0.0};
+  request.goal_pose = {55.0, 0.0, 0.0};
+  return request;
+}
+
+PullOutPath path() {
+  PullOutPath p;
+  p.found = true;
+  p.planner_type = PlannerType::kGeometric;
+  PathWithLaneId back;
+  for (int i = 0; i <= 3; ++i) back.points.push_back({{10.0 - i, 3.25, 0.0}, -1.0, {2}});
+  PathWithLaneId forward;
+  for (int i = 0; i <= 30; ++i) forward.points.push_back({{7.0 + i, 3.25 - 0.1 * i, 0.0}, 2.0, {1}});
+  p.partial_paths = {back, forward};
+  p.pairs_terminal_velocity_and_accel = {{0.0, 0.0}, {2.0, 0.0}};
+  p.start_pose = {7.0, 3.25, 0.0};
+  p.end_pose = {37.0, 0.25, 0.0};
+  return p;
+}
+
+struct Parsed {
+  tinyxml2::XMLDocument doc;
+  const tinyxml2::XMLElement* root{nullptr};
+  std::vector<const tinyxml2::XMLElement*> elements;  // every element, depth first
+};
+
+void collect(const tinyxml2::XMLElement* e, std::vector<const tinyxml2::XMLElement*>& out) {
+  for (; e != nullptr; e = e->NextSiblingElement()) {
+    out.push_back(e);
+    collect(e->FirstChildElement(), out);
+  }
+}
+
+void parse(const std::string& svg, Parsed& parsed) {
+  ASSERT_EQ(parsed.doc.Parse(svg.c_str()), tinyxml2::XML_SUCCESS) << parsed.doc.ErrorStr() << "\n" << svg;
+  parsed.root = parsed.doc.RootElement();
+  ASSERT_NE(parsed.root, nullptr);
+  collect(parsed.root, parsed.elements);
+}
+
+std::vector<const tinyxml2::XMLElement*> with_class(const Parsed& p, const std::string& css_class) {
+  std::vector<const tinyxml2::XMLElement*> out;
+  for (const auto* e : p.elements) {
+    const char* c = e->Attribute("class");
+    if (c != nullptr && css_class == c) out.push_back(e);
+  }
+  return out;
+}
+
+std::vector<Point2> points_of(const tinyxml2::XMLElement* e) {
+  std::vector<Point2> out;
+  std::istringstream in(e->Attribute("points"));
+  std::string pair;
+  while (in >> pair) {
+    Point2 p;
+    EXPECT_EQ(std::sscanf(pair.c_str(), "%lf,%lf", &p.x, &p.y), 2) << pair;
+    out.push_back(p);
+  }
+  return out;
+}
+
+std::string all_text(const Parsed& p) {
+  std::string out;
+  for (const auto* e : p.elements) {
+    if (e->GetText() != nullptr) out += std::string(e->GetText()) + "\n";
+  }
+  return out;
+}
+
+TEST(VehicleFootprint, CornersFromVehicleInfo) {
+  VehicleInfo v;  // wheel_base 2.79, front 1.0, rear 1.1, tread 1.64, overhangs 0.128
+  const auto c = vehicle_footprint(v, {0.0, 0.0, 0.0});
+  EXPECT_NEAR(c[0].x, 3.79, 1e-12);   // front-left
+  EXPECT_NEAR(c[0].y, 0.948, 1e-12);
+  EXPECT_NEAR(c[1].x, -1.1, 1e-12);   // rear-left
+  EXPECT_NEAR(c[2].y, -0.948, 1e-12);  // rear-right
+  // Rotated by 90 deg about base_link at (1, 2): the front points to +y.
+  const auto r = vehicle_footprint(v, {1.0, 2.0, kPi / 2});
+  EXPECT_NEAR(r[0].x, 1.0 - 0.948, 1e-9);
+  EXPECT_NEAR(r[0].y, 2.0 + 3.79, 1e-9);
+}
+
+TEST(ObjectFootprint, BoxOrPolygon) {
+  Object box;
+  box.pose = {10.0, 0.0, kPi};
+  box.length_m = 4.0;
+  box.width_m = 2.0;
+  const auto b = object_footprint(box);
+  ASSERT_EQ(b.size(), 4u);
+  EXPECT_NEAR(b[0].x, 8.0, 1e-9);  // (+2, +1) rotated by pi
+  EXPECT_NEAR(b[0].y, -1.0, 1e-9);
+  Object tri;
+  tri.pose = {1.0, 1.0, 0.0};
+  tri.polygon = {{1.0, 0.0}, {0.0, 1.0}, {0.0, 0.0}};
+  const auto t = object_footprint(tri);
+  ASSERT_EQ(t.size(), 3u);
+  EXPECT_NEAR(t[1].y, 2.0, 1e-12);
+}
+
+TEST(NiceScaleLength, OneTwoFiveSeries) {
+  EXPECT_DOUBLE_EQ(nice_scale_length(7.0), 5.0);
+  EXPECT_DOUBLE_EQ(nice_scale_length(19.0), 10.0);
+  EXPECT_DOUBLE_EQ(nice_scale_length(20.0), 20.0);
+  EXPECT_DOUBLE_EQ(nice_scale_length(0.3), 0.2);
+  EXPECT_DOUBLE_EQ(nice_scale_length(0.0), 1.0);
+}
+
+TEST(RenderSvg, ElementsForEveryPart) {
+  const PullOutRequest request = scene();
+  const PullOutPath p = path();
+  Parsed parsed;
+  parse(render_svg(request, VehicleInfo{}, &p, {1000.0, 800.0, "demo & test"}), parsed);
+  EXPECT_STREQ(parsed.root->Name(), "svg");
+  EXPECT_EQ(with_class(parsed, "lane-road").size(), 1u);
+  EXPECT_EQ(with_class(parsed, "lane-shoulder").size(), 1u);
+  EXPECT_STRNE(with_class(parsed, "lane-road")[0]->Attribute("fill"),
+               with_class(parsed, "lane-shoulder")[0]->Attribute("fill"));
+  EXPECT_EQ(with_class(parsed, "centerline").size(), 1u);
+  EXPECT_EQ(with_class(parsed, "object").size(), 2u);
+  EXPECT_EQ(points_of(with_class(parsed, "object")[1]).size(), 3u);  // the polygon object
+  EXPECT_EQ(with_class(parsed, "footprint-start").size(), 1u);
+  EXPECT_EQ(with_class(parsed, "footprint-end").size(), 1u);
+  const auto segments = with_class(parsed, "segment");
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_STRNE(segments[0]->Attribute("stroke"), segments[1]->Attribute("stroke"));
+  EXPECT_NE(segments[0]->Attribute("stroke-dasharray"), nullptr);  // the reverse segment
+  EXPECT_EQ(segments[1]->Attribute("stroke-dasharray"), nullptr);
+  EXPECT_EQ(points_of(segments[1]).size(), 31u);
+
+  const std::string text = all_text(parsed);
+  for (const char* label : {"road lane", "road shoulder", "object", "vehicle at start", "vehicle at end",
+                            "segment 0 (reverse)", "segment 1 (forward)", "goal", "demo & test", " m"}) {
+    EXPECT_NE(text.find(label), std::string::npos) << label << " in\n" << text;
+  }
+}
+
+TEST(RenderSvg, YAxisPointsUpAndScaleIsUniform) {
+  const PullOutRequest request = scene();
+  Parsed parsed;
+  parse(render_svg(request, VehicleInfo{}, nullptr), parsed);
+  // The shoulder (world y 1.75..4.75) is above the road (world y -1.75..1.75): smaller picture y.
+  const auto road = points_of(with_class(parsed, "lane-road")[0]);
+  const auto shoulder = points_of(with_class(parsed, "lane-shoulder")[0]);
+  // Outline = left bound then reversed right bound: road[0] = (0, 1.75), road[2] = (60, -1.75).
+  EXPECT_LT(shoulder[0].y, road[0].y);
+  EXPECT_GT(road[2].y, road[0].y);
+  const double sx = (road[1].x - road[0].x) / 60.0;
+  const double sy = (road[2].y - road[1].y) / 3.5;
+  EXPECT_NEAR(sx, sy, 0.01 * sx);  // 2-decimal rounding of px coordinates
+  // No path: no end footprint, no segments.
+  EXPECT_TRUE(with_class(parsed, "footprint-end").empty());
+  EXPECT_TRUE(with_class(parsed, "segment").empty());
+}
+
+TEST(RenderSvg, ViewBoxHoldsEverything) {
+  const PullOutRequest request = scene();
+  const PullOutPath p = path();
+  Parsed parsed;
+  parse(render_svg(request, VehicleInfo{}, &p), parsed);
+  double x0 = 0, y0 = 0, w = 0, h = 0;
+  ASSERT_EQ(std::sscanf(parsed.root->Attribute("viewBox"), "%lf %lf %lf %lf", &x0, &y0, &w, &h), 4);
+  EXPECT_DOUBLE_EQ(w, parsed.root->DoubleAttribute("width"));
+  EXPECT_DOUBLE_EQ(h, parsed.root->DoubleAttribute("height"));
+  for (const auto* e : parsed.elements) {
+    if (e->Attribute("points") == nullptr) continue;
+    for (const auto& q : points_of(e)) {
+      EXPECT_GE(q.x, x0);
+      EXPECT_LE(q.x, x0 + w);
+      EXPECT_GE(q.y, y0);
+      EXPECT_LE(q.y, y0 + h);
+    }
+  }
+}
+
+TEST(RenderSvg, SkipsNonFiniteAndHandlesEmptyScene) {
+  PullOutRequest request;  // nothing but the ego pose at the origin
+  PullOutPath p = path();
+  p.partial_paths[1].points[3].pose.x = std::nan("");
+  Parsed parsed;
+  parse(render_svg(request, VehicleInfo{}, &p), parsed);
+  EXPECT_EQ(points_of(with_class(parsed, "segment")[1]).size(), 30u);
+  const std::string svg = render_svg(request, VehicleInfo{}, nullptr);
+  EXPECT_EQ(svg.find("nan"), std::string::npos);
+  EXPECT_EQ(svg.find("inf"), std::string::npos);
+}
+
+TEST(WriteTextFile, WritesAndReportsFailures) {
+  const auto file = std::filesystem::temp_directory_path() / "pullout_test_svg_writer.svg";
+  write_text_file(file.string(), "<svg/>");
+  std::ifstream in(file);
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(content, "<svg/>");
+  std::filesystem::remove(file);
+  EXPECT_THROW(write_text_file("/nonexistent-dir/x.svg", "<svg/>"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace pullout::cli

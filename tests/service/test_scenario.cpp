@@ -1,0 +1,216 @@
+// Loading of scenario files.
+#include "pullout/config/scenario.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace pullout {
+namespace {
+
+const std::string kScenarioDir = std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios";
+
+class ScenarioFile {
+ public:
+  explicit ScenarioFile(const std::string& text) {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = (std::filesystem::temp_directory_path() /
+             ("pullout_test_scenario_" + std::string(info->name()) + "_" + std::to_string(::getpid()) + ".yaml"))
+                .string();
+    std::ofstream(path_) << text;
+  }
+  ~ScenarioFile() {
+    std::error_code ec;
+    std::filesystem::remove(path_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+constexpr const char* kLanes =
+    "lanes:\n"
+    "  - {id: 1, subtype: road, left_bound: [[0, 1.75], [100, 1.75]], right_bound: [[0, -1.75], [100, -1.75]]}\n";
+constexpr const char* kPoses = "start: {x: 10, y: 0}\ngoal: {x: 90, y: 0}\n";
+
+std::vector<std::string> problems_of(const std::string& text) {
+  ScenarioFile file(text);
+  try {
+    load_scenario(file.path());
+  } catch (const ConfigError& e) {
+    return e.problems();
+  }
+  return {};
+}
+
+bool any_starts_with(const std::vector<std::string>& lines, const std::string& prefix) {
+  return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.rfind(prefix, 0) == 0; });
+}
+
+std::string dump(const std::vector<std::string>& lines) {
+  std::string s;
+  for (const auto& l : lines) s += l + "\n";
+  return s;
+}
+
+// The shared scenario (tests/scenarios/straight_shoulder.yaml): a 100 m straight road, lane 1 at
+// y in [-1.75, 1.75], a shoulder lane 2 at y in [1.75, 4.75], start on the shoulder centre.
+TEST(Scenario, StraightShoulderLoads) {
+  const Scenario s = load_scenario(kScenarioDir + "/straight_shoulder.yaml");
+  EXPECT_FALSE(s.description.empty());
+  const PullOutRequest& r = s.request;
+  EXPECT_FALSE(r.vehicle_id.empty());
+  ASSERT_EQ(r.lanes.size(), 2u);
+  EXPECT_EQ(r.lanes[0].id, 1);
+  EXPECT_EQ(r.lanes[0].subtype, LaneSubtype::kRoad);
+  EXPECT_EQ(r.lanes[1].id, 2);
+  EXPECT_EQ(r.lanes[1].subtype, LaneSubtype::kRoadShoulder);
+  ASSERT_EQ(r.lanes[1].left_bound.size(), 2u);
+  EXPECT_DOUBLE_EQ(r.lanes[1].left_bound[0].y, 4.75);
+  EXPECT_DOUBLE_EQ(r.lanes[1].right_bound[1].x, 100.0);
+  EXPECT_GT(r.lanes[0].speed_limit_mps, 0.0);
+  EXPECT_DOUBLE_EQ(r.ego_pose.x, 10.0);
+  EXPECT_DOUBLE_EQ(r.ego_pose.y, 3.25);
+  EXPECT_DOUBLE_EQ(r.ego_pose.yaw, 0.0);
+  EXPECT_DOUBLE_EQ(r.goal_pose.x, 90.0);
+  EXPECT_TRUE(r.objects.empty());
+  ASSERT_TRUE(s.expect.found.has_value());
+  EXPECT_TRUE(*s.expect.found);
+  EXPECT_EQ(s.expect.planner, PlannerType::kShift);
+}
+
+TEST(Scenario, EveryScenarioInTheSuiteLoads) {
+  std::size_t count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kScenarioDir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++count;
+    try {
+      const Scenario s = load_scenario(entry.path().string());
+      EXPECT_FALSE(s.request.lanes.empty()) << entry.path();
+    } catch (const ConfigError& e) {
+      ADD_FAILURE() << e.what();
+    }
+  }
+  EXPECT_GE(count, 1u);
+}
+
+TEST(Scenario, AllFieldsAndOverrides) {
+  ScenarioFile file(std::string(kLanes) +
+                    "description: everything\n"
+                    "vehicle_id: demo-1\n"
+                    "vehicle: {wheel_base: 3.0}\n"
+                    "start: {x: 10.0, y: 3.5, yaw: 0.1}\n"
+                    "start_velocity: 0.2\n"
+                    "goal: {x: 90.0, y: 0.0, yaw_deg: 90}\n"
+                    "objects:\n"
+                    "  - {id: 7, class: car, x: 20.0, y: 3.5, yaw_deg: 180, length: 4.0, width: 1.8, velocity: 0.5}\n"
+                    "  - {class: pedestrian, x: 30, y: 4, polygon: [[-0.3, -0.3], [0.3, -0.3], [0, 0.3]]}\n"
+                    "planner: {search_priority: [SHIFT], lateral_jerk: 0.7}\n"
+                    "deadline_ms: 150\n"
+                    "expect: {found: false, margin: 0.5}\n");
+  Config base;
+  base.vehicle.wheel_tread_m = 1.7;
+  const Scenario s = load_scenario(file.path(), base);
+  EXPECT_EQ(s.request.vehicle_id, "demo-1");
+  EXPECT_DOUBLE_EQ(s.vehicle.wheel_base_m, 3.0);
+  EXPECT_DOUBLE_EQ(s.vehicle.wheel_tread_m, 1.7);  // from the base config
+  EXPECT_DOUBLE_EQ(s.request.ego_pose.yaw, 0.1);
+  EXPECT_DOUBLE_EQ(s.request.ego_velocity_mps, 0.2);
+  EXPECT_NEAR(s.request.goal_pose.yaw, M_PI / 2.0, 1e-12);
+  ASSERT_EQ(s.request.objects.size(), 2u);
+  EXPECT_EQ(s.request.objects[0].id, 7);
+  EXPECT_EQ(s.request.objects[0].object_class, ObjectClass::kCar);
+  EXPECT_NEAR(s.request.objects[0].pose.yaw, M_PI, 1e-12);
+  EXPECT_DOUBLE_EQ(s.request.objects[0].length_m, 4.0);
+  EXPECT_DOUBLE_EQ(s.request.objects[0].velocity_mps, 0.5);
+  EXPECT_EQ(s.request.objects[1].object_class, ObjectClass::kPedestrian);
+  EXPECT_EQ(s.request.objects[1].polygon.size(), 3u);
+  EXPECT_DOUBLE_EQ(s.parameters.lateral_jerk, 0.7);
+  EXPECT_EQ(s.request.overrides.search_priority, std::vector<PlannerType>{PlannerType::kShift});
+  EXPECT_FALSE(s.request.overrides.search_policy.has_value());
+  EXPECT_DOUBLE_EQ(s.request.deadline_ms, 150.0);
+  EXPECT_EQ(s.expect.found, false);
+  EXPECT_EQ(s.expect.margin_m, 0.5);
+}
+
+TEST(Scenario, VehicleIdDefaultsToTheFileName) {
+  ScenarioFile file(std::string(kLanes) + kPoses);
+  const Scenario s = load_scenario(file.path());
+  EXPECT_EQ(s.request.vehicle_id, std::filesystem::path(file.path()).stem().string());
+}
+
+TEST(Scenario, MalformedPointsAreNamed) {
+  const auto p = problems_of(
+      std::string(kPoses) +
+      "lanes:\n"
+      "  - {id: 1, left_bound: [[0, 1.75], [50, 1.75], [100], [100, 1.75]], right_bound: [[0, -1.75], [100, x]]}\n");
+  EXPECT_TRUE(any_starts_with(p, "lanes[0].left_bound[2]: expected [x, y]")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "lanes[0].right_bound[1].y: expected a number")) << dump(p);
+  EXPECT_EQ(p.size(), 2u) << dump(p);
+}
+
+TEST(Scenario, MalformedFieldsAreNamed) {
+  const auto p = problems_of(std::string(kLanes) +
+                             "start: {x: 10, y: ten, yaw: 0, yaw_deg: 0}\n"
+                             "goal: {x: 90}\n"
+                             "objects:\n"
+                             "  - {id: 1, class: spaceship, x: 1, y: 2, length: -4}\n"
+                             "  - {id: 2, class: car, x: 1, y: 2, colour: red}\n"
+                             "planner: {lateral_jerk: fast}\n"
+                             "expect: {planner: teleport}\n"
+                             "deadline_ms: -1\n");
+  EXPECT_TRUE(any_starts_with(p, "start.y: expected a number, got 'ten'")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start.yaw_deg: give either yaw [rad] or yaw_deg, not both")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "goal.y: required")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "objects[0].class: unknown class 'spaceship'")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "objects[0].length: must be > 0")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "objects[1].colour: unknown key")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "planner.lateral_jerk: expected a number")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "expect.planner: unknown planner 'teleport'")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "deadline_ms: must be >= 0")) << dump(p);
+  EXPECT_EQ(p.size(), 9u) << dump(p);
+}
+
+TEST(Scenario, MissingRequiredParts) {
+  const auto p = problems_of("objects: []\n");
+  EXPECT_TRUE(any_starts_with(p, "lanes: required")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start: required")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "goal: required")) << dump(p);
+
+  const auto q = problems_of(std::string(kPoses) + "lanes:\n  - {id: 3, left_bound: [[0, 1]]}\n");
+  EXPECT_TRUE(any_starts_with(q, "lanes[0].left_bound: needs at least 2 points")) << dump(q);
+  EXPECT_TRUE(any_starts_with(q, "lanes[0].right_bound: required")) << dump(q);
+}
+
+TEST(Scenario, MapAndRouteAreNotSupportedYet) {
+  const auto p = problems_of(std::string(kPoses) + "map: maps/test.osm\nroute: [4618, 4635]\n");
+  EXPECT_TRUE(any_starts_with(p, "map: lanelet2 maps are not supported yet")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "route: routes on a lanelet2 map are not supported yet")) << dump(p);
+}
+
+TEST(Scenario, PlannerSectionIsValidated) {
+  const auto p = problems_of(std::string(kLanes) + kPoses +
+                             "planner: {search_priority: [GEOMETRIC], lateral_jerk: 0}\nvehicle: {wheel_base: 0}\n");
+  EXPECT_TRUE(any_starts_with(p, "planner.search_priority[0]: planner 'geometric' is not available")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "planner.lateral_jerk: must be > 0")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "vehicle.wheel_base: must be in")) << dump(p);
+}
+
+TEST(Scenario, UnreadableFile) {
+  try {
+    load_scenario("/nonexistent/scenario.yaml");
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/scenario.yaml: cannot read file");
+  }
+}
+
+}  // namespace
+}  // namespace pullout
