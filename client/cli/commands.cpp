@@ -12,6 +12,7 @@
 #include "pullout/client/client.hpp"
 #include "pullout/config/config.hpp"
 #include "pullout/config/scenario.hpp"
+#include "pullout/model/names.hpp"
 #include "pullout/pipeline/deadline.hpp"
 #include "pullout/pipeline/parameters.hpp"
 #include "pullout/pipeline/start_planner.hpp"

@@ -35,6 +35,9 @@ dds::DataWriterQos command_writer_qos() {
   qos.history().depth = 1;
   // Repair a lost fragment of a large request quickly instead of after the default 3 s.
   qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 200000000);
+  // The types are unbounded: allocate samples as they come instead of preallocating the generated
+  // maximum size per history slot.
+  qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
   return qos;
 }
 
@@ -45,6 +48,7 @@ dds::DataReaderQos reply_reader_qos(int depth) {
   qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
   qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   qos.history().depth = depth;
+  qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
   return qos;
 }
 

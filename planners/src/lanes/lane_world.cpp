@@ -113,19 +113,21 @@ void LaneWorld::build_index() {
       // For a counter-clockwise polygon the outside is on the right of each edge.
       const Vec2 outward = -orientation * left_normal(dir);
       const auto pieces = static_cast<std::size_t>(std::ceil(len / kEdgePieceLength));
+      // Consecutive outer pieces of one edge are merged back into one segment, so that the
+      // departure test sees few long segments.
+      std::optional<Vec2> run_start;
       for (std::size_t p = 0; p < pieces; ++p) {
         const Vec2 pa = a + dir * (len * static_cast<double>(p) / static_cast<double>(pieces));
         const Vec2 pb = a + dir * (len * static_cast<double>(p + 1) / static_cast<double>(pieces));
         const Vec2 probe = 0.5 * (pa + pb) + kSharedEdgeProbe * outward;
-        bool shared = false;
-        for (std::size_t j : lanes_containing(probe)) {
-          if (j != i) {
-            shared = true;
-            break;
-          }
+        const bool shared = inside_other_lane(probe, i);
+        if (!shared && !run_start) run_start = pa;
+        if (shared && run_start) {
+          outer_edges_.emplace_back(*run_start, pa);
+          run_start.reset();
         }
-        if (!shared) outer_edges_.emplace_back(pa, pb);
       }
+      if (run_start) outer_edges_.emplace_back(*run_start, b);
     }
   }
   for (std::size_t e = 0; e < outer_edges_.size(); ++e) {
@@ -145,6 +147,16 @@ std::vector<std::size_t> LaneWorld::lanes_containing(const Vec2& p) const {
     if (lanes_[i].box.contains(p) && point_in_polygon(lanes_[i].polygon, p)) out.push_back(i);
   }
   return out;
+}
+
+bool LaneWorld::inside_other_lane(const Vec2& p, std::size_t lane) const {
+  const auto it = lane_cells_.find(cell_key(static_cast<long>(std::floor(p.x() / cell_size_)),
+                                            static_cast<long>(std::floor(p.y() / cell_size_))));
+  if (it == lane_cells_.end()) return false;
+  for (std::uint32_t i : it->second) {
+    if (i != lane && lanes_[i].box.contains(p) && point_in_polygon(lanes_[i].polygon, p)) return true;
+  }
+  return false;
 }
 
 bool LaneWorld::contains(const Vec2& p) const {

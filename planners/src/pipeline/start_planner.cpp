@@ -154,7 +154,19 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     obstacles.push_back({o.id, object_polygon(o)});
   }
   const ObjectChecker checker(vehicle_footprint(vehicle_), std::move(obstacles));
-  const PlanningContext context{world, road, checker, vehicle_, params, request.goal_pose};
+  // The lanes the vehicle stands in: the shoulder chain when it is on a shoulder, else the road.
+  LaneChain shoulder;
+  const LaneChain* pull_out = &road;
+  for (std::size_t i : world.lanes_containing(to_vec(request.ego_pose))) {
+    if (world.lanes()[i].subtype == LaneSubtype::kRoadShoulder) {
+      shoulder = world.chain_through(i);
+      pull_out = &shoulder;
+      break;
+    }
+  }
+  double horizon = 0.0;
+  for (double m : params.collision_check_margins) horizon = std::max(horizon, m);
+  const PlanningContext context{world, road, *pull_out, checker, vehicle_, params, request.goal_pose, horizon};
 
   std::vector<std::unique_ptr<PullOutPlanner>> planners;
   for (PlannerType t : params.search_priority) {
@@ -178,6 +190,9 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     }
   }
 
+  // Each (start, planner) pair is planned once, on first use; the margin ladder only re-reads
+  // the candidates' clearances.
+  std::vector<std::optional<PlannerCandidates>> planned(starts.size() * planners.size());
   for (double margin : params.collision_check_margins) {
     for (const auto& [ci, pi] : order) {
       if (deadline.expired()) {
@@ -185,12 +200,14 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
         break;
       }
       const StartCandidate& start = starts[ci];
-      PlannerOutput out = planners[pi]->plan(context, start.pose, margin, deadline);
-      if (out.outcome == "timeout") result.timed_out = true;
-      result.evaluation_table.push_back({planners[pi]->type(), margin, start.backward_distance, out.outcome});
-      if (out.path) {
+      auto& slot = planned[ci * planners.size() + pi];
+      if (!slot) slot = planners[pi]->plan(context, start.pose, deadline);
+      result.timed_out = result.timed_out || slot->timed_out;
+      const Selection sel = select_candidate(*slot, margin);
+      result.evaluation_table.push_back({planners[pi]->type(), margin, start.backward_distance, sel.outcome});
+      if (sel.chosen != nullptr) {
         result.outcome = PlanningResult::Outcome::kFound;
-        result.path = std::move(*out.path);
+        result.path = sel.chosen->build();
         result.path.found = true;
         result.path.planner_type = planners[pi]->type();
         // The vehicle moves towards the centerline: right when it starts left of it.

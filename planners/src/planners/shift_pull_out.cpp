@@ -3,8 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
-#include <sstream>
+#include <memory>
 
 #include "pullout/collision/footprint.hpp"
 
@@ -15,15 +14,6 @@ namespace {
 constexpr double kMinShiftLength = 0.01;          // [m] below this the start is on the centerline
 constexpr double kMaxStartYawDeviation = 0.35;    // [rad] (20 deg) between start heading and lane
 constexpr double kGoalOnRoadTolerance = 0.5;      // [m] lateral offset of a goal on the centerline
-constexpr double kTouchingDistance = 1e-6;        // [m] clearance below this is contact
-
-std::string format_double(double v, int precision = 2) {
-  std::ostringstream os;
-  os.setf(std::ios::fixed);
-  os.precision(precision);
-  os << v;
-  return os.str();
-}
 
 // Arc length where the shift may end: the first centerline position at or after s0 whose
 // curvature is below the threshold, or the least curved one if none is (so that the shift does
@@ -115,13 +105,6 @@ RoadEnd find_path_end(const PlanningContext& ctx, double s_start) {
   return end;
 }
 
-std::vector<std::int64_t> lane_ids_at(const PlanningContext& ctx, const Vec2& p, double s) {
-  std::vector<std::int64_t> ids;
-  for (std::size_t i : ctx.world.lanes_containing(p)) ids.push_back(ctx.world.lanes()[i].id);
-  if (ids.empty()) ids.push_back(ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(s)]].id);
-  return ids;
-}
-
 double speed_limit_at(const PlanningContext& ctx, double s) {
   return ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(s)]].speed_limit_mps;
 }
@@ -164,39 +147,10 @@ PathWithLaneId to_path(const PlanningContext& ctx, const Candidate& c, const Roa
     pt.pose = c.poses[i];
     const double limit = speed_limit_at(ctx, c.s[i]);
     pt.longitudinal_velocity_mps = i <= c.shift_end_index ? std::min(limit, v_term) : limit;
-    pt.lane_ids = lane_ids_at(ctx, to_vec(pt.pose), c.s[i]);
+    pt.lane_ids = lane_ids_at(ctx, to_vec(pt.pose), ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(c.s[i])]].id);
   }
   if (end.is_goal) path.points.back().longitudinal_velocity_mps = 0.0;
   return path;
-}
-
-// Lane departure of the footprint over poses [0, last]; returns the first departing index.
-std::optional<std::size_t> first_departure(const PlanningContext& ctx, const std::vector<Pose2>& poses,
-                                           std::size_t last) {
-  const Footprint fp = vehicle_footprint(ctx.vehicle, ctx.parameters.lane_departure_check_expansion_margin);
-  for (std::size_t i = 0; i <= last && i < poses.size(); ++i) {
-    if (!ctx.world.footprint_inside(footprint_corners(fp, poses[i]))) return i;
-  }
-  return std::nullopt;
-}
-
-bool lane_departure_check_required(const PlanningContext& ctx, const Pose2& first) {
-  const auto& p = ctx.parameters;
-  if (!p.check_shift_path_lane_departure) return false;
-  if (!p.allow_check_shift_path_lane_departure_override) return true;
-  // Override: a vehicle already partly outside the lanes may leave them on the way out.
-  const Footprint fp = vehicle_footprint(ctx.vehicle, p.lane_departure_check_expansion_margin);
-  return ctx.world.footprint_inside(footprint_corners(fp, first));
-}
-
-std::string summarize(const std::map<std::string, int>& reasons, int total) {
-  std::string out;
-  for (const auto& [reason, count] : reasons) {
-    if (!out.empty()) out += "; ";
-    out += reason;
-    if (total > 1) out += " (" + std::to_string(count) + "/" + std::to_string(total) + " candidates)";
-  }
-  return out;
 }
 
 }  // namespace
@@ -260,40 +214,56 @@ std::vector<double> lateral_acc_samples(const StartPlannerParameters& p) {
   return out;
 }
 
-PlannerOutput ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start, double margin,
-                                 const Deadline& deadline) const {
+PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start, const Deadline& deadline) const {
   const auto& params = ctx.parameters;
   const Polyline& center = ctx.road.centerline;
-  if (center.size() < 2) return {std::nullopt, "no road centerline"};
+  PlannerCandidates out;
+  if (center.size() < 2) {
+    out.failure = "no road centerline";
+    return out;
+  }
   const auto proj = center.project(to_vec(start));
   const double s_start = proj.s;
   const double shift_length = proj.lateral;
-  if (s_start < 0.0 || s_start >= center.length()) return {std::nullopt, "start pose is not alongside the road lanes"};
+  if (s_start < 0.0 || s_start >= center.length()) {
+    out.failure = "start pose is not alongside the road lanes";
+    return out;
+  }
   const double yaw_dev = normalize_angle(start.yaw - center.yaw_at(s_start));
   if (std::abs(yaw_dev) > kMaxStartYawDeviation) {
-    return {std::nullopt, "start heading deviates " + format_double(yaw_dev * 180.0 / M_PI, 1) +
-                              " deg from the road (limit " + format_double(kMaxStartYawDeviation * 180.0 / M_PI, 0) +
-                              ")"};
+    out.failure = "start heading deviates " + format_fixed(yaw_dev * 180.0 / M_PI, 1) + " deg from the road (limit " +
+                  format_fixed(kMaxStartYawDeviation * 180.0 / M_PI, 0) + ")";
+    return out;
   }
   const RoadEnd end = find_path_end(ctx, s_start);
   const double v_road = speed_limit_at(ctx, s_start);
 
-  std::vector<ShiftKinematics> candidates;
+  std::vector<ShiftKinematics> kinematics;
   if (std::abs(shift_length) < kMinShiftLength) {
     // Already on the centerline: drive straight on, accelerating towards the speed limit.
     ShiftKinematics straight;
     straight.longitudinal_acc = params.maximum_longitudinal_acc;
     straight.terminal_velocity = v_road;
-    candidates.push_back(straight);
+    kinematics.push_back(straight);
   } else {
     for (double a_lat : lateral_acc_samples(params)) {
-      candidates.push_back(compute_shift_kinematics(shift_length, a_lat, v_road, params));
+      kinematics.push_back(compute_shift_kinematics(shift_length, a_lat, v_road, params));
     }
   }
 
-  std::map<std::string, int> failures;
-  for (const ShiftKinematics& k : candidates) {
-    if (deadline.expired()) return {std::nullopt, "timeout"};
+  // Lane departure is checked unless disabled, or (override) unless the vehicle already stands
+  // partly outside the lanes.
+  bool check_lanes = params.check_shift_path_lane_departure;
+  if (check_lanes && params.allow_check_shift_path_lane_departure_override) {
+    check_lanes = !first_lane_departure(ctx, {start}, 0, 0).has_value();
+  }
+
+  for (const ShiftKinematics& k : kinematics) {
+    if (deadline.expired()) {
+      out.timed_out = true;
+      break;
+    }
+    PathCandidate candidate;
     double length = k.distance;
     std::optional<ShiftShape> shape;
     if (k.distance > 0.0) {
@@ -304,48 +274,33 @@ PlannerOutput ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start,
       }
       const double s_end = push_end_to_low_curvature(center, s_start + length, params.end_pose_curvature_threshold);
       if (s_end > end.s - 1e-6) {
-        ++failures[end.is_goal ? "goal too close for the shift" : "road lanes too short for the shift"];
+        candidate.rejection = end.is_goal ? "goal too close for the shift" : "road lanes too short for the shift";
+        out.candidates.push_back(std::move(candidate));
         continue;
       }
       shape.emplace(k.profile, shift_length, s_start, s_end - s_start);
     } else {
       shape.emplace(k.profile, 0.0, s_start, 0.0);
     }
-    const Candidate c = sample_poses(ctx, *shape, s_start, end);
-
-    if (lane_departure_check_required(ctx, c.poses.front())) {
-      if (const auto i = first_departure(ctx, c.poses, c.shift_end_index)) {
-        ++failures["lane departure"];
-        continue;
-      }
-    }
+    auto c = std::make_shared<const Candidate>(sample_poses(ctx, *shape, s_start, end));
     // Collision section: from the start to end_pose + shift_collision_check_distance_from_end.
     const double s_check_end = shape->end() + params.shift_collision_check_distance_from_end;
-    std::size_t last = 0;
-    while (last + 1 < c.s.size() && c.s[last + 1] <= s_check_end) ++last;
-    const std::vector<Pose2> section(c.poses.begin(), c.poses.begin() + static_cast<long>(last) + 1);
-    if (const auto hit = ctx.objects.first_hit(section, margin)) {
-      ++failures["collision with object " + std::to_string(hit->obstacle_id)];
-      continue;
-    }
-    // Past the section, up to the end pose, the margin is not required (Autoware stops checking
-    // there altogether), but the footprint must still not touch an obstacle.
-    const std::vector<Pose2> rest(c.poses.begin() + static_cast<long>(last) + 1,
-                                  c.poses.begin() + static_cast<long>(std::max(last, c.shift_end_index)) + 1);
-    if (const auto hit = ctx.objects.first_hit(rest, kTouchingDistance)) {
-      ++failures["collision with object " + std::to_string(hit->obstacle_id) + " near the end pose"];
-      continue;
-    }
-
-    PullOutPath path;
-    path.start_pose = c.poses.front();
-    path.end_pose = c.poses[c.shift_end_index];
-    path.shift_length_m = std::abs(shift_length) < kMinShiftLength ? 0.0 : shift_length;
-    path.partial_paths.push_back(to_path(ctx, c, end, k.terminal_velocity));
-    path.pairs_terminal_velocity_and_accel.push_back({k.terminal_velocity, k.longitudinal_acc});
-    return {std::move(path), "success"};
+    std::size_t section_last = 0;
+    while (section_last + 1 < c->s.size() && c->s[section_last + 1] <= s_check_end) ++section_last;
+    check_candidate(ctx, c->poses, check_lanes, c->shift_end_index, section_last,
+                    std::max(section_last, c->shift_end_index), candidate);
+    candidate.build = [&ctx, c, end, k, shift_length]() {
+      PullOutPath path;
+      path.start_pose = c->poses.front();
+      path.end_pose = c->poses[c->shift_end_index];
+      path.shift_length_m = std::abs(shift_length) < kMinShiftLength ? 0.0 : shift_length;
+      path.partial_paths.push_back(to_path(ctx, *c, end, k.terminal_velocity));
+      path.pairs_terminal_velocity_and_accel.push_back({k.terminal_velocity, k.longitudinal_acc});
+      return path;
+    };
+    out.candidates.push_back(std::move(candidate));
   }
-  return {std::nullopt, summarize(failures, static_cast<int>(candidates.size()))};
+  return out;
 }
 
 }  // namespace pullout

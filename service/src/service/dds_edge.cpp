@@ -21,6 +21,7 @@
 
 namespace pullout::service {
 namespace dds = eprosima::fastdds::dds;
+using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
 
 namespace {
 
@@ -30,7 +31,7 @@ constexpr int kMinExpectedInstances = 64;
 
 dds::Topic* create_topic(dds::DomainParticipant& participant, const char* name, dds::TopicDataType* type_ptr) {
   dds::TypeSupport type(type_ptr);  // takes ownership
-  if (type.register_type(&participant) != dds::ReturnCode_t::RETCODE_OK) {
+  if (type.register_type(&participant) != ReturnCode_t::RETCODE_OK) {
     throw DdsSetupError(std::string("cannot register type ") + type.get_type_name());
   }
   dds::Topic* topic = participant.create_topic(name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
@@ -96,7 +97,7 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   auto* factory = dds::DomainParticipantFactory::get_instance();
   // Fast DDS only logs a missing or malformed XML file and then silently uses its defaults (all
   // interfaces, shared memory): that must stop the service instead.
-  if (factory->load_XML_profiles_file(config.profiles_file) != dds::ReturnCode_t::RETCODE_OK) {
+  if (factory->load_XML_profiles_file(config.profiles_file) != ReturnCode_t::RETCODE_OK) {
     throw DdsSetupError("cannot load DDS profiles file " + config.profiles_file);
   }
   participant_ = factory->create_participant_with_profile(config.domain_id, config.participant_profile);
@@ -148,11 +149,11 @@ void DdsEdge::check_qos() const {
 void DdsEdge::destroy() noexcept {
   if (participant_ == nullptr) return;
   try {
-    if (participant_->delete_contained_entities() != dds::ReturnCode_t::RETCODE_OK) {
+    if (participant_->delete_contained_entities() != ReturnCode_t::RETCODE_OK) {
       spdlog::error("DDS shutdown: cannot delete the participant's entities");
     }
     if (dds::DomainParticipantFactory::get_instance()->delete_participant(participant_) !=
-        dds::ReturnCode_t::RETCODE_OK) {
+        ReturnCode_t::RETCODE_OK) {
       spdlog::error("DDS shutdown: cannot delete the participant");
     }
   } catch (const std::exception& e) {

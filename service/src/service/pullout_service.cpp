@@ -16,6 +16,7 @@
 
 namespace pullout::service {
 namespace dds = eprosima::fastdds::dds;
+using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
 
 namespace {
 
@@ -87,7 +88,7 @@ void PulloutService::dispatch_loop() {
     dds::ConditionSeq active;
     const auto rc = waitset.wait(active, kDispatcherWakePeriod);
     if (stopping_) break;
-    if (rc != dds::ReturnCode_t::RETCODE_OK && rc != dds::ReturnCode_t::RETCODE_TIMEOUT) {
+    if (rc != ReturnCode_t::RETCODE_OK && rc != ReturnCode_t::RETCODE_TIMEOUT) {
       spdlog::error("dispatcher: WaitSet::wait failed (code {})", rc());
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
@@ -109,7 +110,7 @@ void PulloutService::take_requests() {
   dds::DataReader& reader = dds_.request_reader();
   while (!stopping_) {
     try {
-      if (reader.take_next_sample(&sample, &info) != dds::ReturnCode_t::RETCODE_OK) return;
+      if (reader.take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return;
       if (info.valid_data) handle_request(sample);
     } catch (const std::exception& e) {
       // One bad sample (say an allocation failure on a huge one) must not take the service down.
@@ -124,7 +125,7 @@ void PulloutService::take_progress() {
   dds::DataReader& reader = dds_.progress_reader();
   while (!stopping_) {
     try {
-      if (reader.take_next_sample(&sample, &info) != dds::ReturnCode_t::RETCODE_OK) return;
+      if (reader.take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return;
       if (info.valid_data) handle_progress(sample);
     } catch (const std::exception& e) {
       spdlog::error("progress sample dropped: {}", e.what());

@@ -67,6 +67,7 @@ class LaneWorld {
  private:
   void build_topology();
   void build_index();
+  bool inside_other_lane(const Vec2& p, std::size_t lane) const;
   std::int64_t cell_key(long ix, long iy) const { return (static_cast<std::int64_t>(ix) << 32) ^ (iy & 0xffffffff); }
   template <typename F>
   void for_cells(const Aabb& box, F&& f) const;

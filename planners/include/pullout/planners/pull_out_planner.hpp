@@ -1,8 +1,17 @@
-// The interface every lane-based pull-out planner implements, and what it is given.
+// The interface every lane-based pull-out planner implements, what it is given, and the checks
+// they share.
+//
+// A planner turns one start pose into candidate paths, in its order of preference, and checks each
+// one once: lane departure (a verdict) and the clearance to static obstacles over its collision
+// section (a number). None of that depends on the collision margin, so the pipeline runs a planner
+// once per start pose and walks the margin ladder over the results: a candidate is usable at
+// margin m when it has no rejection and clearance >= m.
 #pragma once
 
-#include <optional>
+#include <functional>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/lanes/lane_world.hpp"
@@ -16,28 +25,72 @@ namespace pullout {
 // Everything a planner reads; built once per request by the pipeline and shared by all attempts.
 struct PlanningContext {
   const LaneWorld& world;
-  const LaneChain& road;         // the road lanes the vehicle pulls out onto, in driving order
-  const ObjectChecker& objects;  // static obstacles
+  const LaneChain& road;          // the road lanes the vehicle pulls out onto, in driving order
+  const LaneChain& pull_out;      // the lanes the vehicle stands in (shoulder chain, or `road`)
+  const ObjectChecker& objects;   // static obstacles
   const VehicleInfo& vehicle;
   const StartPlannerParameters& parameters;
   Pose2 goal;
+  double clearance_horizon{std::numeric_limits<double>::infinity()};  // largest margin of the ladder [m]
 };
 
-struct PlannerOutput {
-  // A candidate path: partial_paths, pairs, start/end pose, shift length filled in; the pipeline
-  // fills the request identity, planner type and turn signal.
-  std::optional<PullOutPath> path;
-  std::string outcome;  // "success", or why not (e.g. "collision with object 7")
+struct PathCandidate {
+  // Why this candidate cannot be used at any margin ("lane departure", ...); empty when usable.
+  std::string rejection;
+  // Smallest distance [m] from the footprint to a static obstacle over the collision-checked
+  // section; +inf when no obstacle is within the context's clearance_horizon.
+  double clearance{std::numeric_limits<double>::infinity()};
+  std::int64_t nearest_obstacle{0};
+  // Builds the full path (partial paths with velocities and lane ids, pairs, start/end pose,
+  // shift length). Only called for the candidate that wins.
+  std::function<PullOutPath()> build;
+};
+
+struct PlannerCandidates {
+  std::vector<PathCandidate> candidates;  // in order of preference
+  std::string failure;                    // why there is no candidate at all, if so
+  bool timed_out{false};
 };
 
 class PullOutPlanner {
  public:
   virtual ~PullOutPlanner() = default;
   virtual PlannerType type() const = 0;
-  // Plans from `start` with static-object clearance `margin` [m]. Must return promptly once the
-  // deadline has expired (outcome "timeout"). Never throws for geometric failure.
-  virtual PlannerOutput plan(const PlanningContext& context, const Pose2& start, double margin,
-                             const Deadline& deadline) const = 0;
+  // Candidates from `start`, each checked. Must return promptly once the deadline has expired
+  // (timed_out = true). Never throws for geometric failure.
+  virtual PlannerCandidates plan(const PlanningContext& context, const Pose2& start,
+                                 const Deadline& deadline) const = 0;
 };
+
+// The first candidate usable at `margin` (nullptr if none), and the evaluation-table outcome:
+// "success", or the reasons with their counts ("collision with object 7 (4/4 candidates)").
+struct Selection {
+  const PathCandidate* chosen{nullptr};
+  std::string outcome;
+};
+Selection select_candidate(const PlannerCandidates& candidates, double margin);
+
+// ---- checks shared by the planners ----
+
+// Index of the first pose in [first, last] whose footprint (expanded by
+// lane_departure_check_expansion_margin) leaves the union of the lanes.
+std::optional<std::size_t> first_lane_departure(const PlanningContext& context, const std::vector<Pose2>& poses,
+                                                std::size_t first, std::size_t last);
+
+// Clearance over poses [first, last] (see PathCandidate::clearance).
+ObjectChecker::Clearance section_clearance(const PlanningContext& context, const std::vector<Pose2>& poses,
+                                           std::size_t first, std::size_t last);
+
+// Fills candidate.rejection / clearance from the standard checks: lane departure over
+// [0, departure_last] (when `check_lanes`), clearance over [0, section_last], and no contact at
+// all over (section_last, contact_last].
+void check_candidate(const PlanningContext& context, const std::vector<Pose2>& poses, bool check_lanes,
+                     std::size_t departure_last, std::size_t section_last, std::size_t contact_last,
+                     PathCandidate& candidate);
+
+// Lane ids of a path point: the lanes containing it, else `fallback`.
+std::vector<std::int64_t> lane_ids_at(const PlanningContext& context, const Vec2& p, std::int64_t fallback);
+
+std::string format_fixed(double value, int precision);
 
 }  // namespace pullout

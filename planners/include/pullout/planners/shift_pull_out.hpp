@@ -75,8 +75,8 @@ std::vector<double> lateral_acc_samples(const StartPlannerParameters& parameters
 class ShiftPullOut final : public PullOutPlanner {
  public:
   PlannerType type() const override { return PlannerType::kShift; }
-  PlannerOutput plan(const PlanningContext& context, const Pose2& start, double margin,
-                     const Deadline& deadline) const override;
+  PlannerCandidates plan(const PlanningContext& context, const Pose2& start,
+                         const Deadline& deadline) const override;
 };
 
 }  // namespace pullout

@@ -1,0 +1,421 @@
+// Integration test of pullout_service over real DDS on loopback.
+//
+// Starts the real pullout_service process (config/pullout.yaml, config/dds/loopback.xml) on a
+// domain of its own, talks to it with plain Fast DDS entities built from the same XML profiles,
+// and checks the messages that come back: paths, statuses, execution progress, rejections, many
+// vehicles at once, and a clean exit on SIGTERM.
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <gtest/gtest.h>
+
+#include "pullout/config/scenario.hpp"
+#include "pullout/idl/convert.hpp"
+#include "pullout/idl/guarded_type.hpp"
+#include "pullout/model/names.hpp"
+
+namespace pullout {
+namespace {
+
+namespace dds = eprosima::fastdds::dds;
+using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
+using Clock = std::chrono::steady_clock;
+
+const std::string kSourceDir = PULLOUT_SOURCE_DIR;
+const std::string kServiceBinary = PULLOUT_SERVICE_BIN;
+const std::string kProfiles = kSourceDir + "/config/dds/loopback.xml";
+constexpr auto kReplyTimeout = std::chrono::seconds(10);
+
+// A domain of this test process's own, so that parallel test runs do not talk to each other.
+int test_domain() { return 100 + static_cast<int>(::getpid() % 100); }
+
+// ---- the service process -----------------------------------------------------------------------
+
+class ServiceProcess {
+ public:
+  void start(int domain) {
+    const std::string config = kSourceDir + "/config/pullout.yaml";
+    const std::string domain_text = std::to_string(domain);
+    std::vector<std::string> args{kServiceBinary, "--config", config, "--domain", domain_text, "--log-level", "warn"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ASSERT_EQ(posix_spawn(&pid_, kServiceBinary.c_str(), nullptr, nullptr, argv.data(), environ), 0);
+  }
+
+  // SIGTERM, then the exit status (or -1 if it had to be killed).
+  int stop(std::chrono::milliseconds timeout = std::chrono::milliseconds(5000)) {
+    if (pid_ <= 0) return -1;
+    ::kill(pid_, SIGTERM);
+    const auto until = Clock::now() + timeout;
+    int status = 0;
+    while (Clock::now() < until) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = 0;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, &status, 0);
+    pid_ = 0;
+    return -1;
+  }
+
+  bool running() {
+    if (pid_ <= 0) return false;
+    int status = 0;
+    if (::waitpid(pid_, &status, WNOHANG) == 0) return true;
+    pid_ = 0;  // exited (and reaped): never signal this pid again
+    return false;
+  }
+
+  ~ServiceProcess() { stop(std::chrono::milliseconds(2000)); }
+
+ private:
+  pid_t pid_{0};
+};
+
+// ---- a minimal client --------------------------------------------------------------------------
+
+template <typename Msg, typename Model>
+class Inbox {
+ public:
+  using Convert = std::function<Model(const Msg&)>;
+  Inbox(dds::DataReader* reader, Convert convert) : reader_(reader), convert_(std::move(convert)) {}
+
+  // Waits until some received sample satisfies `pred`; returns it.
+  std::optional<Model> wait_for(const std::function<bool(const Model&)>& pred,
+                                std::chrono::milliseconds timeout = kReplyTimeout) {
+    const auto until = Clock::now() + timeout;
+    while (true) {
+      drain();
+      for (const auto& s : samples_) {
+        if (pred(s)) return s;
+      }
+      if (Clock::now() >= until) return std::nullopt;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+
+  const std::vector<Model>& samples() {
+    drain();
+    return samples_;
+  }
+
+ private:
+  void drain() {
+    Msg m;
+    dds::SampleInfo info;
+    while (reader_->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data) samples_.push_back(convert_(m));
+    }
+  }
+
+  dds::DataReader* reader_;
+  Convert convert_;
+  std::vector<Model> samples_;
+};
+
+class TestClient {
+ public:
+  explicit TestClient(int domain) {
+    auto* factory = dds::DomainParticipantFactory::get_instance();
+    if (factory->load_XML_profiles_file(kProfiles) != ReturnCode_t::RETCODE_OK) throw std::runtime_error("xml");
+    participant_ = factory->create_participant_with_profile(domain, "pullout_participant");
+    if (participant_ == nullptr) throw std::runtime_error("participant");
+    auto* request_topic = topic("pullout/request", idl::make_guarded_type<msg::PullOutRequestPubSubType>());
+    auto* progress_topic = topic("pullout/progress", idl::make_guarded_type<msg::ExecutionProgressPubSubType>());
+    auto* path_topic = topic("pullout/path", idl::make_guarded_type<msg::PullOutPathPubSubType>());
+    auto* status_topic = topic("pullout/status", idl::make_guarded_type<msg::PullOutStatusPubSubType>());
+    auto* pub = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+    auto* sub = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+    request_writer_ = pub->create_datawriter_with_profile(request_topic, "pullout_request_writer");
+    progress_writer_ = pub->create_datawriter_with_profile(progress_topic, "pullout_progress_writer");
+    auto* path_reader = sub->create_datareader_with_profile(path_topic, "pullout_path_reader");
+    auto* status_reader = sub->create_datareader_with_profile(status_topic, "pullout_status_reader");
+    if (!request_writer_ || !progress_writer_ || !path_reader || !status_reader) throw std::runtime_error("entities");
+    paths = std::make_unique<Inbox<msg::PullOutPath, PullOutPath>>(
+        path_reader, [](const msg::PullOutPath& m) { return idl::from_msg(m); });
+    statuses = std::make_unique<Inbox<msg::PullOutStatus, PullOutStatus>>(
+        status_reader, [](const msg::PullOutStatus& m) { return idl::from_msg(m); });
+  }
+
+  ~TestClient() {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+
+  // Waits until the service's readers and writers are matched.
+  bool wait_matched(std::chrono::milliseconds timeout = std::chrono::milliseconds(15000)) {
+    const auto until = Clock::now() + timeout;
+    while (Clock::now() < until) {
+      dds::PublicationMatchedStatus req;
+      dds::PublicationMatchedStatus prog;
+      request_writer_->get_publication_matched_status(req);
+      progress_writer_->get_publication_matched_status(prog);
+      if (req.current_count >= 1 && prog.current_count >= 1) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+
+  bool send(const PullOutRequest& r) {
+    msg::PullOutRequest m = idl::to_msg(r);
+    return request_writer_->write(&m);
+  }
+  bool send(msg::PullOutRequest m) { return request_writer_->write(&m); }
+  bool send(const ExecutionProgress& p) {
+    msg::ExecutionProgress m = idl::to_msg(p);
+    return progress_writer_->write(&m);
+  }
+
+  std::optional<PullOutStatus> final_status(const std::string& vehicle, std::uint64_t request_id) {
+    return statuses->wait_for([&](const PullOutStatus& s) {
+      return s.vehicle_id == vehicle && s.request_id == request_id && s.state != ExecutionState::kPlanning;
+    });
+  }
+  std::optional<PullOutPath> path_of(const std::string& vehicle, std::uint64_t request_id) {
+    return paths->wait_for(
+        [&](const PullOutPath& p) { return p.vehicle_id == vehicle && p.request_id == request_id; });
+  }
+
+  std::unique_ptr<Inbox<msg::PullOutPath, PullOutPath>> paths;
+  std::unique_ptr<Inbox<msg::PullOutStatus, PullOutStatus>> statuses;
+
+ private:
+  dds::Topic* topic(const char* name, dds::TopicDataType* type_ptr) {
+    dds::TypeSupport type(type_ptr);
+    type.register_type(participant_);
+    return participant_->create_topic(name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+  }
+
+  dds::DomainParticipant* participant_{nullptr};
+  dds::DataWriter* request_writer_{nullptr};
+  dds::DataWriter* progress_writer_{nullptr};
+};
+
+PullOutRequest scenario_request(const std::string& name, const std::string& vehicle, std::uint64_t request_id) {
+  PullOutRequest r = load_scenario(kSourceDir + "/tests/scenarios/" + name + ".yaml").request;
+  r.vehicle_id = vehicle;
+  r.request_id = request_id;
+  return r;
+}
+
+// ---- the tests -------------------------------------------------------------------------------
+
+class ServiceDds : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    service_ = std::make_unique<ServiceProcess>();
+    service_->start(test_domain());
+    client_ = std::make_unique<TestClient>(test_domain());
+    matched_ = client_->wait_matched();
+  }
+  static void TearDownTestSuite() {
+    client_.reset();
+    service_.reset();
+  }
+  void SetUp() override {
+    ASSERT_TRUE(matched_) << "the service did not show up on domain " << test_domain();
+    ASSERT_TRUE(service_->running());
+  }
+
+  static std::unique_ptr<ServiceProcess> service_;
+  static std::unique_ptr<TestClient> client_;
+  static bool matched_;
+};
+
+std::unique_ptr<ServiceProcess> ServiceDds::service_;
+std::unique_ptr<TestClient> ServiceDds::client_;
+bool ServiceDds::matched_ = false;
+
+TEST_F(ServiceDds, FoundPathAndStatus) {
+  ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "found-1", 11)));
+  const auto status = client_->final_status("found-1", 11);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->state, ExecutionState::kExecuting) << status->stop_reason << status->error;
+  EXPECT_EQ(status->current_path_idx, 0u);
+  EXPECT_EQ(status->planner_type, PlannerType::kShift);
+  EXPECT_FALSE(status->evaluation_table.empty());
+  EXPECT_GT(status->planning_time_ms, 0.0);
+
+  const auto path = client_->path_of("found-1", 11);
+  ASSERT_TRUE(path.has_value());
+  EXPECT_TRUE(path->found);
+  EXPECT_EQ(path->planner_type, PlannerType::kShift);
+  ASSERT_GE(path->partial_paths.size(), 1u);
+  EXPECT_EQ(path->partial_paths.size(), path->pairs_terminal_velocity_and_accel.size());
+  EXPECT_EQ(status->segment_count, path->partial_paths.size());
+  for (const auto& segment : path->partial_paths) EXPECT_GE(segment.points.size(), 2u);
+}
+
+TEST_F(ServiceDds, ProgressAdvancesToCompletion) {
+  ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "drive-1", 21)));
+  const auto path = client_->path_of("drive-1", 21);
+  ASSERT_TRUE(path.has_value());
+  ASSERT_TRUE(path->found);
+  const auto executing = client_->final_status("drive-1", 21);
+  ASSERT_TRUE(executing.has_value());
+  ASSERT_EQ(executing->state, ExecutionState::kExecuting);
+
+  std::int64_t stamp = 1'000'000'000;
+  const auto send_progress = [&](std::uint64_t request_id, const Pose2& pose, double v) {
+    ExecutionProgress p;
+    p.vehicle_id = "drive-1";
+    p.request_id = request_id;
+    p.stamp_ns = stamp;
+    p.pose = pose;
+    p.velocity_mps = v;
+    EXPECT_TRUE(client_->send(p));
+    // Keep-last-1: give the service time to take each sample before the next replaces it.
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  };
+
+  // Every segment but the last: stand at its end for longer than th_stopped_time (vehicle clock).
+  const std::size_t n = path->partial_paths.size();
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const Pose2 end = path->partial_paths[i].points.back().pose;
+    send_progress(21, end, 0.0);
+    stamp += 1'500'000'000;
+    send_progress(21, end, 0.0);
+    const auto next = client_->statuses->wait_for([&](const PullOutStatus& s) {
+      return s.vehicle_id == "drive-1" && s.request_id == 21 && s.current_path_idx == i + 1;
+    });
+    ASSERT_TRUE(next.has_value()) << "segment " << i << " did not finish";
+  }
+
+  // Past the end pose, but for a stale request id: ignored.
+  const Pose2 past{path->end_pose.x + 0.5 * std::cos(path->end_pose.yaw),
+                   path->end_pose.y + 0.5 * std::sin(path->end_pose.yaw), path->end_pose.yaw};
+  stamp += 100'000'000;
+  send_progress(20, past, 1.0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  for (const auto& s : client_->statuses->samples()) {
+    if (s.vehicle_id == "drive-1") EXPECT_NE(s.state, ExecutionState::kCompleted);
+  }
+
+  stamp += 100'000'000;
+  send_progress(21, past, 1.0);
+  const auto done = client_->statuses->wait_for([](const PullOutStatus& s) {
+    return s.vehicle_id == "drive-1" && s.request_id == 21 && s.state == ExecutionState::kCompleted;
+  });
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(done->current_path_idx, n - 1);
+}
+
+TEST_F(ServiceDds, NoPathGivesAStopPathWithReasons) {
+  ASSERT_TRUE(client_->send(scenario_request("boxed_in", "boxed-1", 31)));
+  const auto status = client_->final_status("boxed-1", 31);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->state, ExecutionState::kNoPath);
+  EXPECT_FALSE(status->stop_reason.empty());
+  EXPECT_FALSE(status->evaluation_table.empty());
+  const auto path = client_->path_of("boxed-1", 31);
+  ASSERT_TRUE(path.has_value());
+  EXPECT_FALSE(path->found);
+  EXPECT_FALSE(path->reasons.empty());
+  for (const auto& segment : path->partial_paths) {
+    for (const auto& p : segment.points) EXPECT_EQ(p.longitudinal_velocity_mps, 0.0);
+  }
+}
+
+TEST_F(ServiceDds, MalformedRequestIsRejectedNamingTheField) {
+  msg::PullOutRequest m = idl::to_msg(scenario_request("straight_shoulder", "bad-1", 41));
+  m.ego_pose().position().x(std::numeric_limits<double>::quiet_NaN());
+  m.goal_pose().orientation().w(3.0);
+  ASSERT_TRUE(client_->send(m));
+  const auto status = client_->final_status("bad-1", 41);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->state, ExecutionState::kRejected);
+  EXPECT_NE(status->error.find("ego_pose.position: "), std::string::npos) << status->error;
+  EXPECT_NE(status->error.find("goal_pose.orientation: "), std::string::npos) << status->error;
+  const auto path = client_->path_of("bad-1", 41);
+  ASSERT_TRUE(path.has_value());
+  EXPECT_FALSE(path->found);
+  EXPECT_TRUE(path->partial_paths.empty());
+
+  // The same vehicle recovers with a good request, and the service is still up.
+  ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "bad-1", 42)));
+  const auto good = client_->final_status("bad-1", 42);
+  ASSERT_TRUE(good.has_value());
+  EXPECT_EQ(good->state, ExecutionState::kExecuting);
+}
+
+TEST_F(ServiceDds, CoreValidationRejectsAnInconsistentRequest) {
+  PullOutRequest r = scenario_request("straight_shoulder", "nolanes-1", 51);
+  r.lanes.clear();
+  ASSERT_TRUE(client_->send(r));
+  const auto status = client_->final_status("nolanes-1", 51);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->state, ExecutionState::kRejected);
+  EXPECT_FALSE(status->error.empty());
+}
+
+TEST_F(ServiceDds, ManyVehiclesAtOnce) {
+  // More vehicles than Fast DDS's default max_instances (10): the profiles must raise it.
+  constexpr int kVehicles = 24;
+  for (int i = 0; i < kVehicles; ++i) {
+    ASSERT_TRUE(client_->send(scenario_request(i % 4 == 3 ? "boxed_in" : "straight_shoulder",
+                                               "fleet-" + std::to_string(i), 100 + i)));
+  }
+  for (int i = 0; i < kVehicles; ++i) {
+    const std::string id = "fleet-" + std::to_string(i);
+    const auto status = client_->final_status(id, 100 + i);
+    ASSERT_TRUE(status.has_value()) << id;
+    EXPECT_EQ(status->state, i % 4 == 3 ? ExecutionState::kNoPath : ExecutionState::kExecuting) << id;
+    const auto path = client_->path_of(id, 100 + i);
+    ASSERT_TRUE(path.has_value()) << id;
+    EXPECT_EQ(path->found, i % 4 != 3) << id;
+  }
+}
+
+TEST_F(ServiceDds, NewerRequestReplacesTheOlderOne) {
+  // Three requests back to back: the last one is answered; an older one may be answered first
+  // (if its search finished before the next arrived) but never after it.
+  for (std::uint64_t id = 61; id <= 63; ++id) {
+    ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "replace-1", id)));
+  }
+  const auto last = client_->final_status("replace-1", 63);
+  ASSERT_TRUE(last.has_value());
+  EXPECT_EQ(last->state, ExecutionState::kExecuting);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  std::uint64_t latest_seen = 0;
+  for (const auto& s : client_->statuses->samples()) {
+    if (s.vehicle_id != "replace-1") continue;
+    EXPECT_GE(s.request_id, latest_seen) << "an older request was answered after a newer one";
+    latest_seen = std::max(latest_seen, s.request_id);
+  }
+}
+
+// Declared last: when the binary runs all tests in one process this one ends the shared service
+// (under ctest every test runs in a process of its own, with its own service).
+TEST_F(ServiceDds, ZzStopsCleanlyOnSigterm) {
+  const auto t0 = Clock::now();
+  EXPECT_EQ(service_->stop(), 0);
+  EXPECT_LT(Clock::now() - t0, std::chrono::seconds(3));
+  matched_ = false;
+}
+
+}  // namespace
+}  // namespace pullout
