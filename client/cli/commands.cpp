@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <exception>
 #include <optional>
 
@@ -42,7 +42,7 @@ int emit(const PlanReport& report, const PullOutRequest& request, const VehicleI
          const std::string& scenario_file, const OutputOptions& options, std::ostream& out, std::ostream& err) {
   if (options.json) {
     // Strings from the service may hold invalid UTF-8: replace rather than throw.
-    out << to_json(report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+    out << to_json(report).dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
   } else {
     print_report(out, report);
   }
@@ -106,8 +106,7 @@ int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
   const double budget_ms =
       scenario.request.deadline_ms > 0.0 ? scenario.request.deadline_ms : config.service.default_deadline_ms;
   const PlanningResult result = planner.plan(scenario.request, Deadline::after_ms(budget_ms));
-  return emit(make_report(result), scenario.request, scenario.vehicle, options.scenario_file, options.output, out,
-              err);
+  return emit(make_report(result), scenario.request, scenario.vehicle, options.scenario_file, options.output, out, err);
 }
 
 int run_request(const RequestOptions& options, std::ostream& out, std::ostream& err) {
@@ -122,8 +121,8 @@ int run_request(const RequestOptions& options, std::ostream& out, std::ostream& 
     err << "pullout: " << e.what() << '\n';
     return kExitBadInput;
   }
-  const auto deadline =
-      SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(options.timeout_s));
+  const auto deadline = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                                 std::chrono::duration<double>(options.timeout_s));
 
   ClientOptions client_options;
   client_options.vehicle_id = scenario.request.vehicle_id.empty() ? kDefaultVehicleId : scenario.request.vehicle_id;
@@ -156,9 +155,8 @@ int run_request(const RequestOptions& options, std::ostream& out, std::ostream& 
     return kExitCommunication;
   }
 
-  const auto status = wait_sliced(deadline, [&](Client::Duration slice) {
-    return client->wait_for_status(request_id, is_final, slice);
-  });
+  const auto status = wait_sliced(
+      deadline, [&](Client::Duration slice) { return client->wait_for_status(request_id, is_final, slice); });
   if (g_interrupted.load()) return kExitInterrupted;
   if (!status) {
     err << "pullout: no answer to request " << request_id << " within " << options.timeout_s << " s\n";

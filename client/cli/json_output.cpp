@@ -8,18 +8,18 @@ namespace pullout::cli {
 
 namespace {
 
-nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+using Json = nlohmann::ordered_json;
 
-nlohmann::json number(const std::optional<double>& v) { return v ? number(*v) : nlohmann::json(nullptr); }
+Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
-nlohmann::json pose(const Pose2& p) {
-  return nlohmann::json{{"x", number(p.x)}, {"y", number(p.y)}, {"yaw", number(p.yaw)}};
-}
+Json number(const std::optional<double>& v) { return v ? number(*v) : Json(nullptr); }
+
+Json pose(const Pose2& p) { return Json{{"x", number(p.x)}, {"y", number(p.y)}, {"yaw", number(p.yaw)}}; }
 
 }  // namespace
 
-nlohmann::json to_json(const PlanReport& report) {
-  nlohmann::json segments = nlohmann::json::array();
+nlohmann::ordered_json to_json(const PlanReport& report) {
+  Json segments = Json::array();
   for (const auto& s : report.segments) {
     segments.push_back({{"points", s.points},
                         {"direction", s.reverse ? "reverse" : "forward"},
@@ -27,20 +27,20 @@ nlohmann::json to_json(const PlanReport& report) {
                         {"terminal_acceleration", number(s.terminal_accel_mps2)},
                         {"length", number(s.length_m)}});
   }
-  nlohmann::json table = nlohmann::json::array();
+  Json table = Json::array();
   for (const auto& a : report.evaluation_table) {
     table.push_back({{"planner", to_string(a.planner)},
                      {"margin", number(a.margin_m)},
                      {"backward_distance", number(a.backward_distance_m)},
                      {"outcome", a.outcome}});
   }
-  nlohmann::json out;
+  Json out;
   out["found"] = report.found;
   out["planner"] = to_string(report.planner);
   out["state"] = to_string(report.state);
   out["segments"] = std::move(segments);
-  out["start_pose"] = report.path ? pose(report.path->start_pose) : nlohmann::json(nullptr);
-  out["end_pose"] = report.path ? pose(report.path->end_pose) : nlohmann::json(nullptr);
+  out["start_pose"] = report.path ? pose(report.path->start_pose) : Json(nullptr);
+  out["end_pose"] = report.path ? pose(report.path->end_pose) : Json(nullptr);
   out["evaluation_table"] = std::move(table);
   out["planning_time_ms"] = number(report.planning_time_ms);
   out["reasons"] = report.reasons;

@@ -16,7 +16,7 @@
 //     "error": ""                              // rejected: "<field>: <problem>" lines
 //   }
 //
-// Non-finite numbers are written as null.
+// Keys keep the order above (nlohmann::ordered_json). Non-finite numbers are written as null.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -25,6 +25,6 @@
 
 namespace pullout::cli {
 
-nlohmann::json to_json(const PlanReport& report);
+nlohmann::ordered_json to_json(const PlanReport& report);
 
 }  // namespace pullout::cli

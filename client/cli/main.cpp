@@ -36,17 +36,20 @@ int main(int argc, char** argv) {
   pullout::cli::RequestOptions request;
   CLI::App* request_cmd = app.add_subcommand(
       "request",
-      "Send the scenario's request to a running pullout service over DDS and print its answer. The service "
-      "plans with its own vehicle and parameters: the scenario's vehicle and planner sections are not sent.");
+      "Send the scenario's request to a running pullout service over DDS and print its answer (path and "
+      "final status). The service plans with its own vehicle and parameters: of the scenario's vehicle and "
+      "planner sections only planner.search_priority and planner.search_policy are sent (as request "
+      "overrides).");
   request_cmd->add_option("scenario", request.scenario_file, "Scenario file (YAML)")
       ->required()
       ->check(CLI::ExistingFile);
   request_cmd->add_flag("--json", request.output.json, "Print one JSON object instead of text");
   request_cmd->add_option("--svg", request.output.svg_file, "Also draw the scenario and path into this SVG file");
-  request_cmd->add_option("--domain", request.domain_id, "DDS domain id")->capture_default_str()->check(
-      CLI::Range(0, 232));
-  request_cmd->add_option("--profiles", request.profiles_file,
-                          "Fast DDS XML profiles file (default: built-in, loopback only)")
+  request_cmd->add_option("--domain", request.domain_id, "DDS domain id")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 232));
+  request_cmd
+      ->add_option("--profiles", request.profiles_file, "Fast DDS XML profiles file (default: built-in, loopback only)")
       ->check(CLI::ExistingFile);
   request_cmd->add_option("--timeout", request.timeout_s, "Seconds to wait for the service and its answer")
       ->capture_default_str()

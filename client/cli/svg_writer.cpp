@@ -18,8 +18,8 @@ constexpr double kLegendWidthPx = 210.0;
 constexpr double kLegendRowPx = 20.0;
 constexpr double kTitleHeightPx = 24.0;
 constexpr double kScaleBarHeightPx = 36.0;
-constexpr double kPaddingM = 2.0;       // world padding around the drawn content [m]
-constexpr double kMinExtentM = 10.0;    // a picture spans at least this much [m]
+constexpr double kPaddingM = 2.0;     // world padding around the drawn content [m]
+constexpr double kMinExtentM = 10.0;  // a picture spans at least this much [m]
 constexpr double kMaxScalePxPerM = 60.0;
 
 constexpr const char* kRoadFill = "#d9d9d9";
@@ -58,8 +58,8 @@ struct Bounds {
 struct Frame {
   double min_x{0.0};
   double max_y{0.0};
-  double scale{1.0};   // [px/m]
-  double top{0.0};     // picture y of max_y [px]
+  double scale{1.0};  // [px/m]
+  double top{0.0};    // picture y of max_y [px]
   double width_m{0.0};
   double height_m{0.0};
 
@@ -84,11 +84,21 @@ std::string escape_xml(const std::string& text) {
   out.reserve(text.size());
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
       default:
         // Control characters are not allowed in XML 1.0 text.
         if (static_cast<unsigned char>(c) >= 0x20 || c == '\t' || c == '\n') out += c;
@@ -160,11 +170,10 @@ std::vector<LegendEntry> legend_entries(const PullOutRequest& request, const Pul
         {box(std::string("fill=\"") + kShoulderFill + "\" stroke=\"" + kLaneStroke + "\""), "road shoulder"});
   }
   if (!request.objects.empty()) {
-    entries.push_back(
-        {box(std::string("fill=\"") + kObjectFill + "\" stroke=\"" + kObjectStroke + "\""), "object"});
+    entries.push_back({box(std::string("fill=\"") + kObjectFill + "\" stroke=\"" + kObjectStroke + "\""), "object"});
   }
-  entries.push_back({box(std::string("fill=\"") + kStartStroke + "\" fill-opacity=\"0.15\" stroke=\"" +
-                         kStartStroke + "\" stroke-width=\"2\""),
+  entries.push_back({box(std::string("fill=\"") + kStartStroke + "\" fill-opacity=\"0.15\" stroke=\"" + kStartStroke +
+                         "\" stroke-width=\"2\""),
                      "vehicle at start"});
   if (path_drawn(path)) {
     entries.push_back({box(std::string("fill=\"") + kEndStroke + "\" fill-opacity=\"0.15\" stroke=\"" + kEndStroke +
@@ -178,8 +187,8 @@ std::vector<LegendEntry> legend_entries(const PullOutRequest& request, const Pul
                          "segment " + std::to_string(i) + (reverse ? " (reverse)" : " (forward)")});
     }
   }
-  entries.push_back({std::string("<circle cx=\"8\" cy=\"6\" r=\"4\" fill=\"none\" stroke=\"") + kGoalStroke + "\"/>",
-                     "goal"});
+  entries.push_back(
+      {std::string("<circle cx=\"8\" cy=\"6\" r=\"4\" fill=\"none\" stroke=\"") + kGoalStroke + "\"/>", "goal"});
   return entries;
 }
 
@@ -256,8 +265,8 @@ std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle
   f.max_y = cy + height_m / 2.0;
   f.width_m = width_m;
   f.height_m = height_m;
-  f.scale = std::min({options.max_drawing_width_px / width_m, options.max_drawing_height_px / height_m,
-                      kMaxScalePxPerM});
+  f.scale =
+      std::min({options.max_drawing_width_px / width_m, options.max_drawing_height_px / height_m, kMaxScalePxPerM});
   f.top = kMarginPx + (options.title.empty() ? 0.0 : kTitleHeightPx);
   const double drawing_w = width_m * f.scale;
   const double drawing_h = height_m * f.scale;
@@ -278,8 +287,8 @@ std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle
     svg << "  <text class=\"title\" x=\"" << num(kMarginPx) << "\" y=\"" << num(kMarginPx + 12.0)
         << "\" font-size=\"14\">" << escape_xml(options.title) << "</text>\n";
   }
-  svg << "  <rect class=\"frame\" x=\"" << num(kMarginPx) << "\" y=\"" << num(f.top) << "\" width=\""
-      << num(drawing_w) << "\" height=\"" << num(drawing_h) << "\" fill=\"none\" stroke=\"#bfbfbf\"/>\n";
+  svg << "  <rect class=\"frame\" x=\"" << num(kMarginPx) << "\" y=\"" << num(f.top) << "\" width=\"" << num(drawing_w)
+      << "\" height=\"" << num(drawing_h) << "\" fill=\"none\" stroke=\"#bfbfbf\"/>\n";
 
   svg << "  <g id=\"lanes\">\n";
   for (const auto& lane : request.lanes) {
@@ -297,8 +306,8 @@ std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle
   svg << "  <g id=\"objects\">\n";
   for (const auto& object : request.objects) {
     svg << "    <polygon class=\"object\" data-id=\"" << object.id << "\" points=\""
-        << points_attr(f, object_footprint(object)) << "\" fill=\"" << kObjectFill << "\" fill-opacity=\"0.7\" stroke=\""
-        << kObjectStroke << "\" stroke-width=\"1\"/>\n";
+        << points_attr(f, object_footprint(object)) << "\" fill=\"" << kObjectFill
+        << "\" fill-opacity=\"0.7\" stroke=\"" << kObjectStroke << "\" stroke-width=\"1\"/>\n";
   }
   svg << "  </g>\n";
 
@@ -342,7 +351,8 @@ std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle
   // --- legend, right of the drawing ---
   const double legend_x = kMarginPx + drawing_w + kMarginPx;
   svg << "  <g id=\"legend\">\n";
-  svg << "    <text x=\"" << num(legend_x) << "\" y=\"" << num(f.top + 12.0) << "\" font-weight=\"bold\">legend</text>\n";
+  svg << "    <text x=\"" << num(legend_x) << "\" y=\"" << num(f.top + 12.0)
+      << "\" font-weight=\"bold\">legend</text>\n";
   for (std::size_t i = 0; i < legend.size(); ++i) {
     const double row_y = f.top + kLegendRowPx * static_cast<double>(i + 1);
     svg << "    <g transform=\"translate(" << num(legend_x) << ',' << num(row_y + 2.0) << ")\">" << legend[i].swatch

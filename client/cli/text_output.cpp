@@ -24,9 +24,7 @@ std::string format(const char* fmt, Args... args) {
   return s;
 }
 
-std::string optional_number(const std::optional<double>& v) {
-  return v ? format("%.2f", *v) : std::string("-");
-}
+std::string optional_number(const std::optional<double>& v) { return v ? format("%.2f", *v) : std::string("-"); }
 
 std::string pose_text(const Pose2& p) {
   return format("x %.3f m  y %.3f m  yaw %.1f deg", p.x, p.y, p.yaw * kRadToDeg);
@@ -55,9 +53,8 @@ void print_report(std::ostream& out, const PlanReport& report) {
                   "a_end [m/s^2]");
     for (std::size_t i = 0; i < report.segments.size(); ++i) {
       const SegmentSummary& s = report.segments[i];
-      out << format("  %3zu  %-9s %7zu %11.2f %13s %15s\n", i, s.reverse ? "reverse" : "forward", s.points,
-                    s.length_m, optional_number(s.terminal_velocity_mps).c_str(),
-                    optional_number(s.terminal_accel_mps2).c_str());
+      out << format("  %3zu  %-9s %7zu %11.2f %13s %15s\n", i, s.reverse ? "reverse" : "forward", s.points, s.length_m,
+                    optional_number(s.terminal_velocity_mps).c_str(), optional_number(s.terminal_accel_mps2).c_str());
     }
   }
   if (report.path) {
@@ -66,7 +63,8 @@ void print_report(std::ostream& out, const PlanReport& report) {
   }
 
   if (!report.evaluation_table.empty()) {
-    out << "evaluation table (" << report.evaluation_table.size() << " attempts):\n";
+    const std::size_t n = report.evaluation_table.size();
+    out << "evaluation table (" << n << (n == 1 ? " attempt" : " attempts") << "):\n";
     out << format("  %-10s %10s %13s  %s\n", "planner", "margin [m]", "backward [m]", "outcome");
     for (const auto& a : report.evaluation_table) {
       out << format("  %-10s %10.2f %13.2f  %s\n", to_string(a.planner), a.margin_m, a.backward_distance_m,

@@ -69,8 +69,8 @@ void validate_options(const ClientOptions& options) {
     throw std::invalid_argument("ClientOptions.vehicle_id: contains a NUL character");
   }
   if (options.domain_id < 0 || options.domain_id > kMaxDomainId) {
-    throw std::invalid_argument("ClientOptions.domain_id: " + std::to_string(options.domain_id) +
-                                " is outside 0.." + std::to_string(kMaxDomainId));
+    throw std::invalid_argument("ClientOptions.domain_id: " + std::to_string(options.domain_id) + " is outside 0.." +
+                                std::to_string(kMaxDomainId));
   }
 }
 
@@ -231,24 +231,22 @@ void Client::Impl::create_entities() {
     if (topic == nullptr) throw ClientError(std::string("cannot create topic ") + name);
     return topic;
   };
-  dds::Topic* request_topic = create_topic(
-      client_detail::kRequestTopic, register_type(std::make_unique<msg::PullOutRequestPubSubType>().release()));
+  dds::Topic* request_topic = create_topic(client_detail::kRequestTopic,
+                                           register_type(std::make_unique<msg::PullOutRequestPubSubType>().release()));
   dds::Topic* progress_topic = create_topic(
       client_detail::kProgressTopic, register_type(std::make_unique<msg::ExecutionProgressPubSubType>().release()));
-  dds::Topic* path_topic = create_topic(client_detail::kPathTopic,
-                                        register_type(std::make_unique<msg::PullOutPathPubSubType>().release()));
-  dds::Topic* status_topic = create_topic(
-      client_detail::kStatusTopic, register_type(std::make_unique<msg::PullOutStatusPubSubType>().release()));
+  dds::Topic* path_topic =
+      create_topic(client_detail::kPathTopic, register_type(std::make_unique<msg::PullOutPathPubSubType>().release()));
+  dds::Topic* status_topic = create_topic(client_detail::kStatusTopic,
+                                          register_type(std::make_unique<msg::PullOutStatusPubSubType>().release()));
 
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (publisher_ == nullptr || subscriber_ == nullptr) throw ClientError("cannot create a DDS publisher/subscriber");
 
-  request_writer_ =
-      publisher_->create_datawriter(request_topic, writer_qos(client_detail::kRequestWriterProfile));
+  request_writer_ = publisher_->create_datawriter(request_topic, writer_qos(client_detail::kRequestWriterProfile));
   if (request_writer_ == nullptr) throw ClientError("cannot create the pullout/request writer");
-  progress_writer_ =
-      publisher_->create_datawriter(progress_topic, writer_qos(client_detail::kProgressWriterProfile));
+  progress_writer_ = publisher_->create_datawriter(progress_topic, writer_qos(client_detail::kProgressWriterProfile));
   if (progress_writer_ == nullptr) throw ClientError("cannot create the pullout/progress writer");
   path_reader_ = create_reply_reader(path_topic, client_detail::kPathReaderProfile, kPathReaderDepth);
   status_reader_ = create_reply_reader(status_topic, client_detail::kStatusReaderProfile, kStatusReaderDepth);
@@ -260,8 +258,8 @@ dds::DataReader* Client::Impl::create_reply_reader(dds::Topic* topic, const char
   const std::string topic_name = topic->get_name();
   // The name only has to be unique within this participant (one per client).
   dds::ContentFilteredTopic* filtered = participant_->create_contentfilteredtopic(
-      topic_name + "/this_vehicle", topic, client_detail::kVehicleFilterExpression,
-      {options_.vehicle_id}, client_detail::kVehicleFilterClass);
+      topic_name + "/this_vehicle", topic, client_detail::kVehicleFilterExpression, {options_.vehicle_id},
+      client_detail::kVehicleFilterClass);
   if (filtered == nullptr) throw ClientError("cannot create the vehicle filter on " + topic_name);
   dds::DataReader* reader = subscriber_->create_datareader(filtered, reader_qos(profile, depth));
   if (reader == nullptr) throw ClientError("cannot create the " + topic_name + " reader");
@@ -495,8 +493,7 @@ std::optional<PullOutPath> Client::Impl::wait_for_path(std::uint64_t request_id,
   }
 }
 
-std::optional<PullOutStatus> Client::Impl::wait_for_status(std::uint64_t request_id,
-                                                           const StatusPredicate& predicate,
+std::optional<PullOutStatus> Client::Impl::wait_for_status(std::uint64_t request_id, const StatusPredicate& predicate,
                                                            Duration timeout) const {
   const auto deadline = deadline_after(timeout);
   const auto accepts = [&](const PullOutStatus& s) {

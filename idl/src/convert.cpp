@@ -155,8 +155,7 @@ std::vector<msg::Point> points_to_msg(const std::vector<Point2>& points) {
   return out;
 }
 
-std::vector<Point2> checked_points(const std::vector<msg::Point>& points, const std::string& field,
-                                   IssueSink& sink) {
+std::vector<Point2> checked_points(const std::vector<msg::Point>& points, const std::string& field, IssueSink& sink) {
   std::vector<Point2> out;
   out.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) out.push_back(checked_point(points[i], indexed(field, i), sink));
@@ -261,8 +260,8 @@ std::optional<OccupancyGrid> checked_grid(const msg::OccupancyGrid& in, IssueSin
   out.height = in.height();
   const std::uint64_t cells = static_cast<std::uint64_t>(in.width()) * in.height();
   if (in.data().size() != cells) {
-    sink.add(field + ".data", std::to_string(in.data().size()) + " cells, expected width x height = " +
-                                  std::to_string(cells));
+    sink.add(field + ".data",
+             std::to_string(in.data().size()) + " cells, expected width x height = " + std::to_string(cells));
   }
   out.data.assign(in.data().begin(), in.data().end());
   return out;

@@ -12,9 +12,9 @@
 #include <exception>
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "pullout/config/config.hpp"
 #include "pullout/model/names.hpp"
@@ -57,9 +57,7 @@ void setup_logging() {
   spdlog::set_default_logger(logger);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"pullout_service: start (pull-out) planner for automated vehicles, over Fast DDS"};
   std::string config_path;
   int domain_id = -1;
@@ -110,4 +108,18 @@ int main(int argc, char** argv) {
   }
   spdlog::info("pullout_service stopped");
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    // Only reachable if logging itself failed to set up.
+    std::fprintf(stderr, "pullout_service: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "pullout_service: unknown error\n");
+  }
+  return kExitOther;
 }

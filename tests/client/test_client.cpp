@@ -13,6 +13,7 @@
 
 #include <unistd.h>
 
+#include <gtest/gtest.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -21,7 +22,6 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
-#include <gtest/gtest.h>
 
 #include "dds_qos.hpp"
 #include "pullout/client/client.hpp"
@@ -191,7 +191,8 @@ TEST(ClientOptionsTest, InvalidOptionsThrow) {
 }
 
 TEST(ClientOptionsTest, ProfilesFileNeedsTheParticipantProfile) {
-  const auto file = std::filesystem::temp_directory_path() / ("pullout_client_test_" + std::to_string(::getpid()) + ".xml");
+  const auto file =
+      std::filesystem::temp_directory_path() / ("pullout_client_test_" + std::to_string(::getpid()) + ".xml");
   std::ofstream(file) << R"(<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"><profiles>
   <transport_descriptors><transport_descriptor>
@@ -359,6 +360,20 @@ TEST(ClientTest, WaitsTimeOutAndSkipOtherRequests) {
       1, [](const PullOutStatus& s) { return s.state == ExecutionState::kCompleted; }, 100ms));
   // No request yet and no path adopted: progress has nothing to refer to.
   EXPECT_THROW(client.report_progress(ExecutionProgress{}), std::logic_error);
+}
+
+TEST(ClientTest, UnboundedWaitReturnsWhenTheReplyArrives) {
+  FakeService service;
+  Client client(options("car-9"));
+  ASSERT_TRUE(client.wait_for_service(10s));
+  std::thread publisher([&] {
+    std::this_thread::sleep_for(100ms);
+    service.publish(make_path("car-9", 5));
+  });
+  const auto path = client.wait_for_path(5, Client::Duration::max());
+  publisher.join();
+  ASSERT_TRUE(path.has_value());
+  EXPECT_EQ(path->request_id, 5u);
 }
 
 TEST(ClientTest, LargePathArrives) {

@@ -46,8 +46,7 @@ PlanningResult found_result() {
   PlanningResult result;
   result.outcome = PlanningResult::Outcome::kFound;
   result.path = two_segment_path();
-  result.evaluation_table = {{PlannerType::kShift, 2.0, 0.0, "collision"},
-                             {PlannerType::kShift, 1.0, 3.0, "success"}};
+  result.evaluation_table = {{PlannerType::kShift, 2.0, 0.0, "collision"}, {PlannerType::kShift, 1.0, 3.0, "success"}};
   result.planning_time_ms = 4.25;
   return result;
 }
@@ -78,7 +77,7 @@ TEST(SummarizeSegments, StoppedSegmentTakesDirectionFromGeometry) {
 
 TEST(JsonOutput, FoundPlanHasEveryField) {
   const PlanReport report = make_report(found_result());
-  const nlohmann::json j = to_json(report);
+  const nlohmann::ordered_json j = to_json(report);
   ASSERT_TRUE(j.is_object());
   for (const char* key : {"found", "planner", "state", "segments", "start_pose", "end_pose", "evaluation_table",
                           "planning_time_ms", "reasons", "error"}) {
@@ -105,8 +104,10 @@ TEST(JsonOutput, FoundPlanHasEveryField) {
   EXPECT_TRUE(j["reasons"].is_array() && j["reasons"].empty());
   EXPECT_EQ(j["error"], "");
   EXPECT_EQ(exit_code(report), 0);
-  // Round trip through text: one object.
-  EXPECT_EQ(nlohmann::json::parse(j.dump()), j);
+  // Keys in the documented order; a round trip through text gives the same object.
+  EXPECT_EQ(j.dump().rfind("{\"found\":true,\"planner\":\"shift\",\"state\":\"executing\",\"segments\":", 0), 0u)
+      << j.dump();
+  EXPECT_EQ(nlohmann::ordered_json::parse(j.dump()), j);
 }
 
 TEST(JsonOutput, NoPathCarriesReasonsAndStopReasonOnce) {
@@ -118,7 +119,7 @@ TEST(JsonOutput, NoPathCarriesReasonsAndStopReasonOnce) {
   result.stop_reason = "no start candidate";  // already among the reasons: not repeated
   result.timed_out = true;
   const PlanReport report = make_report(result);
-  const nlohmann::json j = to_json(report);
+  const nlohmann::ordered_json j = to_json(report);
   EXPECT_EQ(j["found"], false);
   EXPECT_EQ(j["state"], "no_path");
   ASSERT_EQ(j["reasons"].size(), 3u);
@@ -132,7 +133,7 @@ TEST(JsonOutput, RejectedHasErrorLinesAndNoPoses) {
   result.outcome = PlanningResult::Outcome::kRejected;
   result.issues = {{"lanes[0].left_bound", "fewer than 2 points"}, {"goal_pose.yaw", "not finite"}};
   const PlanReport report = make_report(result);
-  const nlohmann::json j = to_json(report);
+  const nlohmann::ordered_json j = to_json(report);
   EXPECT_EQ(j["state"], "rejected");
   EXPECT_TRUE(j["start_pose"].is_null());
   EXPECT_TRUE(j["end_pose"].is_null());
@@ -148,7 +149,7 @@ TEST(JsonOutput, ServiceReplyUsesStatusTableAndState) {
   status.planner_type = PlannerType::kShift;
   status.evaluation_table = {{PlannerType::kShift, 1.0, 0.0, "success"}};
   status.planning_time_ms = 1.5;
-  const nlohmann::json j = to_json(make_report(two_segment_path(), status));
+  const nlohmann::ordered_json j = to_json(make_report(two_segment_path(), status));
   EXPECT_EQ(j["found"], true);
   EXPECT_EQ(j["state"], "executing");
   EXPECT_EQ(j["segments"].size(), 2u);
@@ -167,7 +168,7 @@ TEST(JsonOutput, NonFiniteNumbersBecomeNull) {
   PlanReport report = make_report(found_result());
   report.planning_time_ms = std::numeric_limits<double>::quiet_NaN();
   report.path->end_pose.x = std::numeric_limits<double>::infinity();
-  const nlohmann::json j = to_json(report);
+  const nlohmann::ordered_json j = to_json(report);
   EXPECT_TRUE(j["planning_time_ms"].is_null());
   EXPECT_TRUE(j["end_pose"]["x"].is_null());
   EXPECT_EQ(nlohmann::json::parse(j.dump())["end_pose"]["y"], 3.5);

@@ -114,9 +114,9 @@ std::string all_text(const Parsed& p) {
 TEST(VehicleFootprint, CornersFromVehicleInfo) {
   VehicleInfo v;  // wheel_base 2.79, front 1.0, rear 1.1, tread 1.64, overhangs 0.128
   const auto c = vehicle_footprint(v, {0.0, 0.0, 0.0});
-  EXPECT_NEAR(c[0].x, 3.79, 1e-12);   // front-left
+  EXPECT_NEAR(c[0].x, 3.79, 1e-12);  // front-left
   EXPECT_NEAR(c[0].y, 0.948, 1e-12);
-  EXPECT_NEAR(c[1].x, -1.1, 1e-12);   // rear-left
+  EXPECT_NEAR(c[1].x, -1.1, 1e-12);    // rear-left
   EXPECT_NEAR(c[2].y, -0.948, 1e-12);  // rear-right
   // Rotated by 90 deg about base_link at (1, 2): the front points to +y.
   const auto r = vehicle_footprint(v, {1.0, 2.0, kPi / 2});

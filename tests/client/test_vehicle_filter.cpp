@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include <fastdds/dds/core/LoanableSequence.hpp>
 #include <gtest/gtest.h>
+#include <fastdds/dds/core/LoanableSequence.hpp>
 
 #include "pullout/msg/pulloutPubSubTypes.h"
 #include "vehicle_filter.hpp"

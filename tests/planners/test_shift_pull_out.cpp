@@ -206,7 +206,9 @@ TEST(ShiftPullOut, StartOnTheCenterlineDrivesStraightOn) {
 }
 
 TEST(ShiftPullOut, StartHeadingFarFromTheLaneIsRefused) {
-  const StartPlanner planner(VehicleInfo{}, StartPlannerParameters{});
+  StartPlannerParameters params;
+  params.enable_back = false;  // backed-up candidates are aligned with the lane
+  const StartPlanner planner(VehicleInfo{}, params);
   auto req = test::straight_shoulder_request();
   req.ego_pose.yaw = 0.8;
   const PlanningResult r = planner.plan(req, Deadline());

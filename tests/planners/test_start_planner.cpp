@@ -17,6 +17,17 @@ const StartPlanner& default_planner() {
   return planner;
 }
 
+// Shift from the current pose only: the margin ladder alone decides.
+const StartPlanner& shift_only_planner() {
+  static const StartPlanner planner = [] {
+    StartPlannerParameters p;
+    p.enable_back = false;
+    p.search_priority = {PlannerType::kShift};
+    return StartPlanner(VehicleInfo{}, p);
+  }();
+  return planner;
+}
+
 bool has_issue(const PlanningResult& r, const std::string& field) {
   for (const auto& i : r.issues) {
     if (i.field == field) return true;
@@ -42,7 +53,7 @@ double min_clearance(const PullOutPath& path, const std::vector<Object>& objects
 TEST(StartPlanner, ParkedCarAheadForcesASmallerMargin) {
   auto req = test::straight_shoulder_request();
   req.objects.push_back(test::parked_car(7, 24.0, 3.25));
-  const PlanningResult r = default_planner().plan(req, Deadline());
+  const PlanningResult r = shift_only_planner().plan(req, Deadline());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
   // Every larger margin was tried first and failed for the car.
   ASSERT_GE(r.evaluation_table.size(), 2u);
@@ -60,7 +71,7 @@ TEST(StartPlanner, BoxedInGivesAStopPathWithEveryAttemptsReason) {
   auto req = test::straight_shoulder_request();
   req.objects.push_back(test::parked_car(7, 16.5, 3.25));  // 0.46 m ahead of the bumper
   req.objects.push_back(test::parked_car(8, 5.0, 3.25));   // behind
-  const PlanningResult r = default_planner().plan(req, Deadline());
+  const PlanningResult r = shift_only_planner().plan(req, Deadline());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
   EXPECT_FALSE(r.path.found);
   EXPECT_EQ(r.path.planner_type, PlannerType::kStop);
@@ -96,7 +107,7 @@ TEST(StartPlanner, ExpiredDeadlineEndsTheSearchWithTimeout) {
 
 TEST(StartPlanner, SearchPolicyOverrideAndUnavailablePlanner) {
   auto req = test::straight_shoulder_request();
-  req.overrides.search_priority = {PlannerType::kGeometric};
+  req.overrides.search_priority = {PlannerType::kFreespace};
   const PlanningResult r = default_planner().plan(req, Deadline());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
   EXPECT_TRUE(has_issue(r, "overrides.search_priority[0]"));

@@ -197,8 +197,8 @@ TEST(Scenario, MapAndRouteAreNotSupportedYet) {
 
 TEST(Scenario, PlannerSectionIsValidated) {
   const auto p = problems_of(std::string(kLanes) + kPoses +
-                             "planner: {search_priority: [GEOMETRIC], lateral_jerk: 0}\nvehicle: {wheel_base: 0}\n");
-  EXPECT_TRUE(any_starts_with(p, "planner.search_priority[0]: planner 'geometric' is not available")) << dump(p);
+                             "planner: {search_priority: [SHIFT, SHIFT], lateral_jerk: 0}\nvehicle: {wheel_base: 0}\n");
+  EXPECT_TRUE(any_starts_with(p, "planner.search_priority[1]: planner 'shift' is listed twice")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "planner.lateral_jerk: must be > 0")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "vehicle.wheel_base: must be in")) << dump(p);
 }

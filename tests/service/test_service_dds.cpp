@@ -11,14 +11,18 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -27,7 +31,6 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-#include <gtest/gtest.h>
 
 #include "pullout/config/scenario.hpp"
 #include "pullout/idl/convert.hpp"
@@ -58,6 +61,7 @@ class ServiceProcess {
     const std::string domain_text = std::to_string(domain);
     std::vector<std::string> args{kServiceBinary, "--config", config, "--domain", domain_text, "--log-level", "warn"};
     std::vector<char*> argv;
+    argv.reserve(args.size() + 1);
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
     ASSERT_EQ(posix_spawn(&pid_, kServiceBinary.c_str(), nullptr, nullptr, argv.data(), environ), 0);
@@ -80,6 +84,22 @@ class ServiceProcess {
     ::waitpid(pid_, &status, 0);
     pid_ = 0;
     return -1;
+  }
+
+  pid_t pid() const { return pid_; }
+
+  // User + system CPU time of the process so far [s].
+  double cpu_seconds() const {
+    std::ifstream in("/proc/" + std::to_string(pid_) + "/stat");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // Fields after the command name (which may contain spaces) start after the last ')'.
+    std::istringstream fields(text.substr(text.rfind(')') + 2));
+    std::string field;
+    double ticks = 0.0;
+    for (int i = 3; i <= 15 && fields >> field; ++i) {
+      if (i == 14 || i == 15) ticks += std::stod(field);  // utime, stime
+    }
+    return ticks / static_cast<double>(::sysconf(_SC_CLK_TCK));
   }
 
   bool running() {
@@ -196,8 +216,7 @@ class TestClient {
     });
   }
   std::optional<PullOutPath> path_of(const std::string& vehicle, std::uint64_t request_id) {
-    return paths->wait_for(
-        [&](const PullOutPath& p) { return p.vehicle_id == vehicle && p.request_id == request_id; });
+    return paths->wait_for([&](const PullOutPath& p) { return p.vehicle_id == vehicle && p.request_id == request_id; });
   }
 
   std::unique_ptr<Inbox<msg::PullOutPath, PullOutPath>> paths;
@@ -312,7 +331,9 @@ TEST_F(ServiceDds, ProgressAdvancesToCompletion) {
   send_progress(20, past, 1.0);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   for (const auto& s : client_->statuses->samples()) {
-    if (s.vehicle_id == "drive-1") EXPECT_NE(s.state, ExecutionState::kCompleted);
+    if (s.vehicle_id == "drive-1") {
+      EXPECT_NE(s.state, ExecutionState::kCompleted);
+    }
   }
 
   stamp += 100'000'000;
@@ -376,8 +397,8 @@ TEST_F(ServiceDds, ManyVehiclesAtOnce) {
   // More vehicles than Fast DDS's default max_instances (10): the profiles must raise it.
   constexpr int kVehicles = 24;
   for (int i = 0; i < kVehicles; ++i) {
-    ASSERT_TRUE(client_->send(scenario_request(i % 4 == 3 ? "boxed_in" : "straight_shoulder",
-                                               "fleet-" + std::to_string(i), 100 + i)));
+    ASSERT_TRUE(client_->send(
+        scenario_request(i % 4 == 3 ? "boxed_in" : "straight_shoulder", "fleet-" + std::to_string(i), 100 + i)));
   }
   for (int i = 0; i < kVehicles; ++i) {
     const std::string id = "fleet-" + std::to_string(i);
@@ -406,6 +427,63 @@ TEST_F(ServiceDds, NewerRequestReplacesTheOlderOne) {
     EXPECT_GE(s.request_id, latest_seen) << "an older request was answered after a newer one";
     latest_seen = std::max(latest_seen, s.request_id);
   }
+}
+
+// Resamples a polyline to `n` points evenly spaced between its first and last point.
+std::vector<Point2> resampled(const std::vector<Point2>& line, std::size_t n) {
+  std::vector<Point2> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / static_cast<double>(n - 1);
+    out.push_back(
+        {line.front().x + t * (line.back().x - line.front().x), line.front().y + t * (line.back().y - line.front().y)});
+  }
+  return out;
+}
+
+TEST_F(ServiceDds, LargeRequestArrivesAndIsPlanned) {
+  // 4 bounds of 5,000 points: a request of about 500 KB, fragmented over UDP.
+  PullOutRequest r = scenario_request("straight_shoulder", "large-1", 71);
+  for (auto& lane : r.lanes) {
+    lane.left_bound = resampled(lane.left_bound, 5000);
+    lane.right_bound = resampled(lane.right_bound, 5000);
+  }
+  // What is tested is the transport, not the planner's speed on dense lanes: a generous budget.
+  r.deadline_ms = 5000.0;
+  const auto t0 = Clock::now();
+  ASSERT_TRUE(client_->send(r));
+  const auto status = client_->final_status("large-1", 71);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->state, ExecutionState::kExecuting) << status->error << status->stop_reason;
+  const double round_trip_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  EXPECT_LT(round_trip_ms - status->planning_time_ms, 1000.0)
+      << "transport took " << round_trip_ms - status->planning_time_ms << " ms";
+  std::printf("large request: round trip %.1f ms, planning %.1f ms\n", round_trip_ms, status->planning_time_ms);
+}
+
+TEST_F(ServiceDds, RequestOverTheLimitsIsRejected) {
+  // service.limits.max_points_per_line is 10,000 in the shipped config.
+  PullOutRequest r = scenario_request("straight_shoulder", "huge-1", 81);
+  r.lanes[0].left_bound = resampled(r.lanes[0].left_bound, 10001);
+  ASSERT_TRUE(client_->send(r));
+  const auto status = client_->final_status("huge-1", 81);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->state, ExecutionState::kRejected);
+  EXPECT_NE(status->error.find("lanes[0].left_bound"), std::string::npos) << status->error;
+}
+
+TEST_F(ServiceDds, IdleServiceDoesNotSpin) {
+  // After traffic on both readers, the dispatcher must sleep in its WaitSet, not poll.
+  ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "idle-1", 91)));
+  ASSERT_TRUE(client_->final_status("idle-1", 91).has_value());
+  ExecutionProgress p;
+  p.vehicle_id = "idle-1";
+  p.request_id = 91;
+  p.pose = scenario_request("straight_shoulder", "idle-1", 91).ego_pose;
+  ASSERT_TRUE(client_->send(p));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const double before = service_->cpu_seconds();
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  EXPECT_LT(service_->cpu_seconds() - before, 0.2);
 }
 
 // Declared last: when the binary runs all tests in one process this one ends the shared service

@@ -114,6 +114,16 @@ std::size_t ObjectChecker::obstacle_count() const { return impl_->obstacles.size
 const Footprint& ObjectChecker::footprint() const { return impl_->footprint; }
 
 ObjectChecker::Clearance ObjectChecker::clearance(const Pose2& pose, double horizon) const {
+  return clearance_if(pose, horizon, [](const Vec2&) { return true; });
+}
+
+ObjectChecker::Clearance ObjectChecker::clearance_ahead(const Pose2& pose, double horizon) const {
+  const double front = impl_->footprint.front;
+  return clearance_if(pose, horizon, [&pose, front](const Vec2& centre) { return to_local(pose, centre).x() > front; });
+}
+
+template <typename Filter>
+ObjectChecker::Clearance ObjectChecker::clearance_if(const Pose2& pose, double horizon, Filter&& keep) const {
   Clearance best;
   if (impl_->obstacles.empty()) return best;
   const Vec2 box_centre = to_global(pose, impl_->box_offset);
@@ -124,6 +134,7 @@ ObjectChecker::Clearance ObjectChecker::clearance(const Pose2& pose, double hori
   // test_object_checker.cpp catches it); its own GJK implementation is exact to 1e-6 m.
   request.gjk_solver_type = fcl::GST_INDEP;
   for (const PreparedObstacle& o : impl_->obstacles) {
+    if (!keep(o.centre)) continue;
     // Lower bound of the distance from the two bounding circles.
     const double lower = (o.centre - box_centre).norm() - o.radius - impl_->box_radius;
     if (lower >= horizon || lower >= best.distance) continue;

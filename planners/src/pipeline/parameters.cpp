@@ -22,8 +22,8 @@ bool is_search_planner(PlannerType p) {
 // "shift, geometric": the planners this version implements (planner_available), for messages.
 std::string available_planner_names() {
   std::string names;
-  for (const PlannerType p : {PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid,
-                              PlannerType::kFreespace}) {
+  for (const PlannerType p :
+       {PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid, PlannerType::kFreespace}) {
     if (!planner_available(p)) continue;
     if (!names.empty()) names += ", ";
     names += to_string(p);
@@ -149,12 +149,41 @@ std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p)
   c.positive("maximum_lateral_acc", p.maximum_lateral_acc);
   if (std::isfinite(p.minimum_lateral_acc) && std::isfinite(p.maximum_lateral_acc) &&
       p.minimum_lateral_acc > p.maximum_lateral_acc) {
-    c.fail("maximum_lateral_acc", "must be >= minimum_lateral_acc (" + text(p.minimum_lateral_acc) + "), got " +
-                                      text(p.maximum_lateral_acc));
+    c.fail("maximum_lateral_acc",
+           "must be >= minimum_lateral_acc (" + text(p.minimum_lateral_acc) + "), got " + text(p.maximum_lateral_acc));
   }
   c.positive("maximum_curvature", p.maximum_curvature);
   c.positive("end_pose_curvature_threshold", p.end_pose_curvature_threshold);
   c.positive("maximum_longitudinal_acc", p.maximum_longitudinal_acc);
+
+  c.in_range("max_back_distance", p.max_back_distance, 0.0, 200.0);
+  // With the limits above this bounds the start candidates to at most 2001.
+  c.in_range("backward_search_resolution", p.backward_search_resolution, 0.1, 100.0);
+  c.in_range("collision_check_margin_from_front_object", p.collision_check_margin_from_front_object, 0.0, 50.0);
+  c.non_negative("ignore_distance_from_lane_end", p.ignore_distance_from_lane_end);
+  if (c.finite("backward_velocity", p.backward_velocity) &&
+      !(p.backward_velocity < 0.0 && p.backward_velocity >= -10.0)) {
+    c.fail("backward_velocity", "must be in [-10, 0) (reversing), got " + text(p.backward_velocity));
+  }
+
+  c.in_range("geometric_pull_out_velocity", p.geometric_pull_out_velocity, 0.01, 20.0);
+  c.in_range("arc_path_interval", p.arc_path_interval, 0.05, 10.0);
+  c.in_range("lane_departure_margin", p.lane_departure_margin, 0.0, 5.0);
+  c.in_range("geometric_pull_out_max_steer_angle_margin_scale", p.geometric_pull_out_max_steer_angle_margin_scale, 0.01,
+             1.0);
+  c.finite("geometric_collision_check_distance_from_end", p.geometric_collision_check_distance_from_end);
+
+  c.in_range("clothoid_initial_velocity", p.clothoid_initial_velocity, 0.01, 20.0);
+  c.in_range("clothoid_acceleration", p.clothoid_acceleration, 0.0, 10.0);
+  if (p.clothoid_max_steer_angles_deg.empty() || p.clothoid_max_steer_angles_deg.size() > 16) {
+    c.fail("clothoid_max_steer_angles_deg", "must list 1 to 16 angles");
+  }
+  for (std::size_t i = 0; i < p.clothoid_max_steer_angles_deg.size(); ++i) {
+    c.in_range("clothoid_max_steer_angles_deg[" + std::to_string(i) + "]", p.clothoid_max_steer_angles_deg[i], 0.5,
+               80.0);
+  }
+  c.in_range("clothoid_max_steer_angle_rate_deg_per_sec", p.clothoid_max_steer_angle_rate_deg_per_sec, 0.1, 1000.0);
+  c.finite("clothoid_collision_check_distance_from_end", p.clothoid_collision_check_distance_from_end);
   return issues;
 }
 

@@ -10,7 +10,10 @@
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/lanes/lane_world.hpp"
 #include "pullout/model/names.hpp"
+#include "pullout/planners/clothoid_pull_out.hpp"
+#include "pullout/planners/geometric_pull_out.hpp"
 #include "pullout/planners/shift_pull_out.hpp"
+#include "start_candidates.hpp"
 #include "validation.hpp"
 
 namespace pullout {
@@ -18,7 +21,8 @@ namespace pullout {
 namespace {
 
 const std::vector<PlannerType>& available_planners() {
-  static const std::vector<PlannerType> kAvailable{PlannerType::kShift};
+  static const std::vector<PlannerType> kAvailable{PlannerType::kShift, PlannerType::kGeometric,
+                                                   PlannerType::kClothoid};
   return kAvailable;
 }
 
@@ -26,6 +30,10 @@ std::unique_ptr<PullOutPlanner> make_planner(PlannerType type) {
   switch (type) {
     case PlannerType::kShift:
       return std::make_unique<ShiftPullOut>();
+    case PlannerType::kGeometric:
+      return std::make_unique<GeometricPullOut>();
+    case PlannerType::kClothoid:
+      return std::make_unique<ClothoidPullOut>();
     default:
       return nullptr;
   }
@@ -172,12 +180,12 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   for (PlannerType t : params.search_priority) {
     if (auto p = make_planner(t)) planners.push_back(std::move(p));
   }
-  // Start candidates: the current pose only (backward start-pose search is a later extension).
-  struct StartCandidate {
-    Pose2 pose;
-    double backward_distance;
-  };
-  const std::vector<StartCandidate> starts{{request.ego_pose, 0.0}};
+  // Start candidates: the current pose, then poses behind it (enable_back).
+  const StartCandidateSearch search = search_start_candidates(context, request.ego_pose);
+  const std::vector<StartCandidate>& starts = search.candidates;
+  for (const std::string& line : search.skipped) {
+    result.evaluation_table.push_back({PlannerType::kNone, 0.0, 0.0, line});
+  }
   // The order of (candidate, planner) pairs inside one margin, per search_policy.
   std::vector<std::pair<std::size_t, std::size_t>> order;
   if (params.search_policy == SearchPolicy::kPlannerPriority) {
@@ -214,6 +222,15 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
         result.path.turn_signal = result.path.shift_length_m > 0.0   ? TurnSignal::kRight
                                   : result.path.shift_length_m < 0.0 ? TurnSignal::kLeft
                                                                      : TurnSignal::kNone;
+        if (start.backward_distance > 0.0) {
+          // Reverse to the start candidate first. Pair: cruise at backward_velocity, reached
+          // over half the segment (a = v^2 / L) so that the vehicle stops at its end.
+          const double v = params.backward_velocity;
+          result.path.partial_paths.insert(result.path.partial_paths.begin(),
+                                           reverse_segment(context, request.ego_pose, start));
+          result.path.pairs_terminal_velocity_and_accel.insert(result.path.pairs_terminal_velocity_and_accel.begin(),
+                                                               {v, -v * v / start.backward_distance});
+        }
         finish(result);
         return result;
       }
@@ -232,6 +249,9 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   } else if (planners.empty()) {
     result.stop_reason = "no planner enabled";
     result.path.reasons.push_back(result.stop_reason);
+  } else if (starts.empty()) {
+    result.stop_reason = "no start pose candidate: boxed in";
+    result.path.reasons = search.skipped;
   } else {
     result.stop_reason = "no safe path at any collision margin";
   }

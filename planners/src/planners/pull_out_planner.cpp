@@ -1,5 +1,7 @@
 #include "pullout/planners/pull_out_planner.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <sstream>
 
@@ -8,7 +10,46 @@
 namespace pullout {
 
 namespace {
-constexpr double kTouchingDistance = 1e-6;  // [m] clearance below this is contact
+constexpr double kTouchingDistance = 1e-6;    // [m] clearance below this is contact
+constexpr double kGoalOnRoadTolerance = 0.5;  // [m] lateral offset of a goal on the centerline
+}  // namespace
+
+RoadEnd find_path_end(const PlanningContext& ctx, double s_from) {
+  const Polyline& center = ctx.road.centerline;
+  RoadEnd end{std::min(s_from + ctx.parameters.forward_path_length, center.length()), false};
+  const auto g = center.project(to_vec(ctx.goal));
+  if (std::abs(g.lateral) <= kGoalOnRoadTolerance && g.s > s_from && g.s <= end.s) end = {g.s, true};
+  return end;
+}
+
+double speed_limit_at(const PlanningContext& ctx, double s) {
+  return ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(s)]].speed_limit_mps;
+}
+
+std::int64_t road_lane_id_at(const PlanningContext& ctx, double s) {
+  return ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(s)]].id;
+}
+
+Polyline centerline_window(const PlanningContext& ctx, double s0, double s1, double interval) {
+  const Polyline& center = ctx.road.centerline;
+  return center.resampled(interval, std::clamp(s0, 0.0, center.length()), std::clamp(s1, 0.0, center.length()));
+}
+
+std::vector<PathPoint> centerline_points(const PlanningContext& ctx, double s0, const RoadEnd& end) {
+  std::vector<PathPoint> out;
+  const double step = ctx.parameters.center_line_path_interval;
+  // Skip a first point closer than half a step to s0: it would duplicate the joint.
+  for (double s = s0 + step; s < end.s + 0.5 * step; s += step) {
+    const double si = std::min(s, end.s);
+    PathPoint p;
+    p.pose = ctx.road.centerline.pose_at(si);
+    p.longitudinal_velocity_mps = speed_limit_at(ctx, si);
+    p.lane_ids = lane_ids_at(ctx, to_vec(p.pose), road_lane_id_at(ctx, si));
+    out.push_back(std::move(p));
+    if (si >= end.s) break;
+  }
+  if (!out.empty() && end.is_goal) out.back().longitudinal_velocity_mps = 0.0;
+  return out;
 }
 
 std::string format_fixed(double value, int precision) {
@@ -48,8 +89,8 @@ Selection select_candidate(const PlannerCandidates& pc, double margin) {
 }
 
 std::optional<std::size_t> first_lane_departure(const PlanningContext& ctx, const std::vector<Pose2>& poses,
-                                                std::size_t first, std::size_t last) {
-  const Footprint fp = vehicle_footprint(ctx.vehicle, ctx.parameters.lane_departure_check_expansion_margin);
+                                                std::size_t first, std::size_t last, double expansion) {
+  const Footprint fp = vehicle_footprint(ctx.vehicle, expansion);
   for (std::size_t i = first; i <= last && i < poses.size(); ++i) {
     if (!ctx.world.footprint_inside(footprint_corners(fp, poses[i]))) return i;
   }
@@ -67,11 +108,12 @@ ObjectChecker::Clearance section_clearance(const PlanningContext& ctx, const std
   return best;
 }
 
-void check_candidate(const PlanningContext& ctx, const std::vector<Pose2>& poses, bool check_lanes,
-                     std::size_t departure_last, std::size_t section_last, std::size_t contact_last,
+void check_candidate(const PlanningContext& ctx, const std::vector<Pose2>& poses, const CandidateChecks& checks,
                      PathCandidate& candidate) {
-  if (check_lanes) {
-    if (const auto i = first_lane_departure(ctx, poses, 0, departure_last)) {
+  const std::size_t section_last = checks.section_last;
+  const std::size_t contact_last = checks.contact_last;
+  if (checks.check_lanes) {
+    if (first_lane_departure(ctx, poses, 0, checks.departure_last, checks.expansion)) {
       candidate.rejection = "lane departure";
       return;
     }

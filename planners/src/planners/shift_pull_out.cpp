@@ -13,7 +13,6 @@ namespace {
 
 constexpr double kMinShiftLength = 0.01;          // [m] below this the start is on the centerline
 constexpr double kMaxStartYawDeviation = 0.35;    // [rad] (20 deg) between start heading and lane
-constexpr double kGoalOnRoadTolerance = 0.5;      // [m] lateral offset of a goal on the centerline
 
 // Arc length where the shift may end: the first centerline position at or after s0 whose
 // curvature is below the threshold, or the least curved one if none is (so that the shift does
@@ -92,23 +91,6 @@ double shifted_length(const Polyline& center, const ShiftShape& shape, double s_
   return total;
 }
 
-struct RoadEnd {
-  double s{0.0};
-  bool is_goal{false};
-};
-
-RoadEnd find_path_end(const PlanningContext& ctx, double s_start) {
-  const Polyline& center = ctx.road.centerline;
-  RoadEnd end{std::min(s_start + ctx.parameters.forward_path_length, center.length()), false};
-  const auto g = center.project(to_vec(ctx.goal));
-  if (std::abs(g.lateral) <= kGoalOnRoadTolerance && g.s > s_start && g.s <= end.s) end = {g.s, true};
-  return end;
-}
-
-double speed_limit_at(const PlanningContext& ctx, double s) {
-  return ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(s)]].speed_limit_mps;
-}
-
 struct Candidate {
   std::vector<Pose2> poses;
   std::vector<double> s;  // centerline arc length of each pose
@@ -147,7 +129,7 @@ PathWithLaneId to_path(const PlanningContext& ctx, const Candidate& c, const Roa
     pt.pose = c.poses[i];
     const double limit = speed_limit_at(ctx, c.s[i]);
     pt.longitudinal_velocity_mps = i <= c.shift_end_index ? std::min(limit, v_term) : limit;
-    pt.lane_ids = lane_ids_at(ctx, to_vec(pt.pose), ctx.world.lanes()[ctx.road.lanes[ctx.road.lane_at(c.s[i])]].id);
+    pt.lane_ids = lane_ids_at(ctx, to_vec(pt.pose), road_lane_id_at(ctx, c.s[i]));
   }
   if (end.is_goal) path.points.back().longitudinal_velocity_mps = 0.0;
   return path;
@@ -255,7 +237,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
   // partly outside the lanes.
   bool check_lanes = params.check_shift_path_lane_departure;
   if (check_lanes && params.allow_check_shift_path_lane_departure_override) {
-    check_lanes = !first_lane_departure(ctx, {start}, 0, 0).has_value();
+    check_lanes = !first_lane_departure(ctx, {start}, 0, 0, params.lane_departure_check_expansion_margin).has_value();
   }
 
   for (const ShiftKinematics& k : kinematics) {
@@ -287,8 +269,10 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
     const double s_check_end = shape->end() + params.shift_collision_check_distance_from_end;
     std::size_t section_last = 0;
     while (section_last + 1 < c->s.size() && c->s[section_last + 1] <= s_check_end) ++section_last;
-    check_candidate(ctx, c->poses, check_lanes, c->shift_end_index, section_last,
-                    std::max(section_last, c->shift_end_index), candidate);
+    check_candidate(ctx, c->poses,
+                    {check_lanes, params.lane_departure_check_expansion_margin, c->shift_end_index, section_last,
+                     std::max(section_last, c->shift_end_index)},
+                    candidate);
     candidate.build = [&ctx, c, end, k, shift_length]() {
       PullOutPath path;
       path.start_pose = c->poses.front();

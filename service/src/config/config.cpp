@@ -26,7 +26,7 @@ std::string join_lines(const std::string& file, const std::vector<std::string>& 
   std::string out;
   for (const auto& p : problems) {
     if (!out.empty()) out += '\n';
-    out += file + ": " + p;
+    out.append(file).append(": ").append(p);
   }
   return out;
 }
@@ -34,17 +34,18 @@ std::string join_lines(const std::string& file, const std::vector<std::string>& 
 // Autoware start_planner parameters that this version does not implement: a clearer message
 // than "unknown key" for users who bring Autoware's file along.
 const char* start_planner_hint(const std::string& key) {
-  static constexpr std::array<std::string_view, 29> kAutowareOnly{
-      "collision_check_margin_from_front_object", "skip_rear_vehicle_check", "extra_width_margin_for_rear_obstacle",
-      "th_distance_to_middle_of_the_road",        "maximum_longitudinal_deviation", "minimum_shift_length",
-      "geometric_collision_check_distance_from_end", "arc_path_interval",         "divide_pull_out_path",
-      "geometric_pull_out_velocity",              "lane_departure_margin",         "backward_velocity",
-      "geometric_pull_out_max_steer_angle_margin_scale", "clothoid_initial_velocity", "clothoid_acceleration",
-      "clothoid_max_steer_angles_deg",            "clothoid_max_steer_angle_rate_deg_per_sec",
-      "clothoid_collision_check_distance_from_end", "check_clothoid_path_lane_departure", "enable_back",
-      "max_back_distance",                        "backward_search_resolution",    "backward_path_update_duration",
-      "ignore_distance_from_lane_end",            "prepare_time_before_start",     "turn_signal_on_centerline_start",
-      "freespace_planner",                        "path_safety_check",             "surround_moving_obstacle_check",
+  static constexpr std::array<std::string_view, 11> kAutowareOnly{
+      "skip_rear_vehicle_check",
+      "extra_width_margin_for_rear_obstacle",
+      "th_distance_to_middle_of_the_road",
+      "maximum_longitudinal_deviation",
+      "minimum_shift_length",
+      "backward_path_update_duration",
+      "prepare_time_before_start",
+      "turn_signal_on_centerline_start",
+      "freespace_planner",
+      "path_safety_check",
+      "surround_moving_obstacle_check",
   };
   if (std::find(kAutowareOnly.begin(), kAutowareOnly.end(), key) != kAutowareOnly.end()) {
     return "Autoware parameter not supported in this version";
@@ -57,22 +58,23 @@ std::string lower(std::string s) {
   return s;
 }
 
-void read_margins(MapReader& r, std::vector<double>& out) {
-  const YAML::Node n = r.get("collision_check_margins");
+// A list of numbers; `what` says what they are in the message ("margins [m]").
+void read_number_list(MapReader& r, const std::string& key, const char* what, std::vector<double>& out) {
+  const YAML::Node n = r.get(key);
   if (!n.IsDefined()) return;
-  const std::string path = r.key_path("collision_check_margins");
+  const std::string path = r.key_path(key);
   if (!n.IsSequence()) {
-    r.problems().push_back(path + ": expected a list of margins [m]" + yaml_fields::where(n));
+    r.problems().push_back(path + ": expected a list of " + what + yaml_fields::where(n));
     return;
   }
-  std::vector<double> margins;
+  std::vector<double> values;
   bool ok = true;
   for (std::size_t i = 0; i < n.size(); ++i) {
     const auto v = yaml_fields::to_double(n[i], yaml_fields::indexed(path, i), r.problems());
     ok = ok && v.has_value();
-    if (v) margins.push_back(*v);
+    if (v) values.push_back(*v);
   }
-  if (ok) out = std::move(margins);
+  if (ok) out = std::move(values);
 }
 
 void read_search_priority(MapReader& r, std::vector<PlannerType>& out) {
@@ -232,7 +234,7 @@ std::optional<PlannerType> parse_planner_name(const std::string& name) {
 }
 
 bool is_log_level(const std::string& level) {
-  static constexpr std::array<std::string_view, 7> kLevels{"trace", "debug", "info", "warn",
+  static constexpr std::array<std::string_view, 7> kLevels{"trace", "debug",    "info", "warn",
                                                            "error", "critical", "off"};
   return std::find(kLevels.begin(), kLevels.end(), level) != kLevels.end();
 }
@@ -268,15 +270,15 @@ void append_parameter_issues(const std::vector<ParameterIssue>& issues, const st
 ConfigError::ConfigError(const std::string& file, std::vector<std::string> problems)
     : std::runtime_error(join_lines(file, problems)), problems_(std::move(problems)) {}
 
-void apply_start_planner_parameters(const YAML::Node& node, const std::string& prefix,
-                                    StartPlannerParameters& params, std::vector<std::string>& problems) {
+void apply_start_planner_parameters(const YAML::Node& node, const std::string& prefix, StartPlannerParameters& params,
+                                    std::vector<std::string>& problems) {
   MapReader r(node, prefix, problems);
   if (!r.valid()) return;
   StartPlannerParameters& p = params;
   r.read("th_arrived_distance", p.th_arrived_distance);
   r.read("th_stopped_velocity", p.th_stopped_velocity);
   r.read("th_stopped_time", p.th_stopped_time);
-  read_margins(r, p.collision_check_margins);
+  read_number_list(r, "collision_check_margins", "margins [m]", p.collision_check_margins);
   read_search_priority(r, p.search_priority);
   read_search_policy(r, p.search_policy);
   r.read("th_moving_object_velocity", p.th_moving_object_velocity);
@@ -295,6 +297,27 @@ void apply_start_planner_parameters(const YAML::Node& node, const std::string& p
   r.read("maximum_curvature", p.maximum_curvature);
   r.read("end_pose_curvature_threshold", p.end_pose_curvature_threshold);
   r.read("maximum_longitudinal_acc", p.maximum_longitudinal_acc);
+
+  r.read("enable_back", p.enable_back);
+  r.read("max_back_distance", p.max_back_distance);
+  r.read("backward_search_resolution", p.backward_search_resolution);
+  r.read("collision_check_margin_from_front_object", p.collision_check_margin_from_front_object);
+  r.read("ignore_distance_from_lane_end", p.ignore_distance_from_lane_end);
+  r.read("backward_velocity", p.backward_velocity);
+
+  r.read("geometric_pull_out_velocity", p.geometric_pull_out_velocity);
+  r.read("arc_path_interval", p.arc_path_interval);
+  r.read("lane_departure_margin", p.lane_departure_margin);
+  r.read("geometric_pull_out_max_steer_angle_margin_scale", p.geometric_pull_out_max_steer_angle_margin_scale);
+  r.read("divide_pull_out_path", p.divide_pull_out_path);
+  r.read("geometric_collision_check_distance_from_end", p.geometric_collision_check_distance_from_end);
+
+  r.read("clothoid_initial_velocity", p.clothoid_initial_velocity);
+  r.read("clothoid_acceleration", p.clothoid_acceleration);
+  read_number_list(r, "clothoid_max_steer_angles_deg", "steering angles [deg]", p.clothoid_max_steer_angles_deg);
+  r.read("clothoid_max_steer_angle_rate_deg_per_sec", p.clothoid_max_steer_angle_rate_deg_per_sec);
+  r.read("clothoid_collision_check_distance_from_end", p.clothoid_collision_check_distance_from_end);
+  r.read("check_clothoid_path_lane_departure", p.check_clothoid_path_lane_departure);
   r.finish(&start_planner_hint);
 }
 

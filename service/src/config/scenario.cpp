@@ -217,16 +217,16 @@ Scenario load_scenario(const std::string& path, const Config& base) {
     problems.push_back("route: routes on a lanelet2 map are not supported yet: give the lanes inline (lanes:)");
   }
 
-  request.lanes = read_list<Lane>(root, "lanes", [&](const YAML::Node& n, const std::string& p, std::size_t) {
-    return read_lane(n, p, problems);
-  });
+  request.lanes = read_list<Lane>(
+      root, "lanes", [&](const YAML::Node& n, const std::string& p, std::size_t) { return read_lane(n, p, problems); });
   if (!root.has("lanes") && !root.has("map")) problems.push_back("lanes: required (the inline lanes)");
 
   request.ego_pose = read_pose(root, "start", true);
   root.read("start_velocity", request.ego_velocity_mps);
   request.goal_pose = read_pose(root, "goal", true);
-  request.objects = read_list<Object>(root, "objects", [&](const YAML::Node& n, const std::string& p,
-                                                           std::size_t i) { return read_object(n, p, i, problems); });
+  request.objects = read_list<Object>(root, "objects", [&](const YAML::Node& n, const std::string& p, std::size_t i) {
+    return read_object(n, p, i, problems);
+  });
 
   if (root.has("planner")) {
     const YAML::Node planner = root.get("planner");

@@ -2,6 +2,7 @@
 
 #include <exception>
 
+#include <spdlog/spdlog.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -13,7 +14,6 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fastdds/dds/topic/qos/TopicQos.hpp>
-#include <spdlog/spdlog.h>
 
 #include "pullout/idl/convert.hpp"
 #include "pullout/idl/guarded_type.hpp"
@@ -152,8 +152,7 @@ void DdsEdge::destroy() noexcept {
     if (participant_->delete_contained_entities() != ReturnCode_t::RETCODE_OK) {
       spdlog::error("DDS shutdown: cannot delete the participant's entities");
     }
-    if (dds::DomainParticipantFactory::get_instance()->delete_participant(participant_) !=
-        ReturnCode_t::RETCODE_OK) {
+    if (dds::DomainParticipantFactory::get_instance()->delete_participant(participant_) != ReturnCode_t::RETCODE_OK) {
       spdlog::error("DDS shutdown: cannot delete the participant");
     }
   } catch (const std::exception& e) {

@@ -5,11 +5,11 @@
 #include <utility>
 #include <vector>
 
+#include <spdlog/spdlog.h>
 #include <fastdds/dds/core/condition/StatusCondition.hpp>
 #include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <spdlog/spdlog.h>
 
 #include "pullout/idl/convert.hpp"
 #include "pullout/model/names.hpp"
@@ -199,10 +199,10 @@ void PulloutService::run_job(PlanningJob& job) {
                  request.request_id, to_string(result.path.planner_type), result.path.partial_paths.size(),
                  result.planning_time_ms, waited_ms);
   } else {
-    spdlog::info("vehicle '{}' request {}: {}{}, {:.1f} ms: {}", request.vehicle_id, request.request_id,
-                 outcome_name(result.outcome), result.timed_out ? " (deadline)" : "", result.planning_time_ms,
-                 result.outcome == PlanningResult::Outcome::kRejected ? format_issues(result.issues)
-                                                                      : result.stop_reason);
+    spdlog::info(
+        "vehicle '{}' request {}: {}{}, {:.1f} ms: {}", request.vehicle_id, request.request_id,
+        outcome_name(result.outcome), result.timed_out ? " (deadline)" : "", result.planning_time_ms,
+        result.outcome == PlanningResult::Outcome::kRejected ? format_issues(result.issues) : result.stop_reason);
   }
 }
 

@@ -154,9 +154,10 @@ void VehicleRegistry::fail(const PlanningJob& job, const std::string& what) {
   if (v->sequence != job.sequence) return;
   v->cancel.reset();
   v->tracker.clear();
+  const std::string reason = "internal error: " + what;
   PullOutStatus status = status_for(request.vehicle_id, request.request_id, ExecutionState::kNoPath);
-  status.stop_reason = "internal error: " + what;
-  publish_result(*v, empty_path(request.vehicle_id, request.request_id, {status.stop_reason}), std::move(status));
+  status.stop_reason = reason;
+  publish_result(*v, empty_path(request.vehicle_id, request.request_id, {reason}), std::move(status));
 }
 
 void VehicleRegistry::publish_result(Vehicle& v, const PullOutPath& path, PullOutStatus status) {

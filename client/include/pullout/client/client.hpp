@@ -20,7 +20,9 @@
 // order, with no internal lock held, so a callback may call any member function except the
 // destructor. A slow callback delays later callbacks, not the blocking waits (state is updated
 // before callbacks run). Callbacks must not throw; an exception escaping a callback is caught and
-// reported through the Fast DDS log (category "PULLOUT_CLIENT").
+// reported through the Fast DDS log (category "PULLOUT_CLIENT"). A blocking wait called from a
+// callback only sees what was received before that callback (the thread that would deliver newer
+// samples is the one running the callback), so it times out rather than seeing new replies.
 //
 // Lifetime: the destructor stops the client's thread (waiting for a running callback to return),
 // then deletes every DDS entity. Do not destroy a Client from one of its callbacks, nor while
@@ -129,7 +131,9 @@ class PULLOUT_CLIENT_EXPORT Client {
   std::optional<std::uint32_t> current_segment() const;
 
   // Blocks until the request writer and the path and status readers are each matched with a
-  // service endpoint, or the timeout expires. Returns whether they are.
+  // service endpoint, or the timeout expires. Returns whether they are. Discovery on loopback
+  // usually takes tens of milliseconds but can take a few seconds (lost announcements are repeated
+  // periodically): allow several seconds.
   bool wait_for_service(Duration timeout) const;
 
   const std::string& vehicle_id() const;

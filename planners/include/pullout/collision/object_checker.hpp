@@ -37,6 +37,10 @@ class ObjectChecker {
   // obstacles closer than `horizon` (others report +inf).
   Clearance clearance(const Pose2& pose, double horizon = std::numeric_limits<double>::infinity()) const;
 
+  // The same, over the obstacles whose centre lies ahead of the vehicle's front (a car parked
+  // beside the vehicle is not ahead of it).
+  Clearance clearance_ahead(const Pose2& pose, double horizon = std::numeric_limits<double>::infinity()) const;
+
   // First pose whose clearance is below `margin`, with the obstacle it hits; nullopt if none.
   struct Hit {
     std::size_t pose_index{0};
@@ -49,6 +53,9 @@ class ObjectChecker {
   const Footprint& footprint() const;
 
  private:
+  template <typename Filter>
+  Clearance clearance_if(const Pose2& pose, double horizon, Filter&& keep) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

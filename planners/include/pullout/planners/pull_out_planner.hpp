@@ -72,25 +72,46 @@ Selection select_candidate(const PlannerCandidates& candidates, double margin);
 
 // ---- checks shared by the planners ----
 
-// Index of the first pose in [first, last] whose footprint (expanded by
-// lane_departure_check_expansion_margin) leaves the union of the lanes.
+// Index of the first pose in [first, last] whose footprint, expanded by `expansion` [m], leaves
+// the union of the lanes.
 std::optional<std::size_t> first_lane_departure(const PlanningContext& context, const std::vector<Pose2>& poses,
-                                                std::size_t first, std::size_t last);
+                                                std::size_t first, std::size_t last, double expansion);
 
 // Clearance over poses [first, last] (see PathCandidate::clearance).
 ObjectChecker::Clearance section_clearance(const PlanningContext& context, const std::vector<Pose2>& poses,
                                            std::size_t first, std::size_t last);
 
 // Fills candidate.rejection / clearance from the standard checks: lane departure over
-// [0, departure_last] (when `check_lanes`), clearance over [0, section_last], and no contact at
-// all over (section_last, contact_last].
-void check_candidate(const PlanningContext& context, const std::vector<Pose2>& poses, bool check_lanes,
-                     std::size_t departure_last, std::size_t section_last, std::size_t contact_last,
+// [0, departure_last] with the footprint expanded by `expansion` (when `check_lanes`), clearance
+// over [0, section_last], and no contact at all over (section_last, contact_last].
+struct CandidateChecks {
+  bool check_lanes{true};
+  double expansion{0.0};
+  std::size_t departure_last{0};
+  std::size_t section_last{0};
+  std::size_t contact_last{0};
+};
+void check_candidate(const PlanningContext& context, const std::vector<Pose2>& poses, const CandidateChecks& checks,
                      PathCandidate& candidate);
 
 // Lane ids of a path point: the lanes containing it, else `fallback`.
 std::vector<std::int64_t> lane_ids_at(const PlanningContext& context, const Vec2& p, std::int64_t fallback);
 
 std::string format_fixed(double value, int precision);
+
+// Where a path starting at road arc length s_from ends: at the goal when it lies on the road
+// centerline ahead within forward_path_length, else forward_path_length ahead (or the road's end).
+struct RoadEnd {
+  double s{0.0};
+  bool is_goal{false};
+};
+RoadEnd find_path_end(const PlanningContext& context, double s_from);
+double speed_limit_at(const PlanningContext& context, double s);   // of the road lane at s
+std::int64_t road_lane_id_at(const PlanningContext& context, double s);
+// The road centerline between s0 and s1 (clamped), resampled every `interval`.
+Polyline centerline_window(const PlanningContext& context, double s0, double s1, double interval);
+// Road centerline points from s0 (excluded) to end.s (included) every center_line_path_interval,
+// with lane ids and the lane speed limit (0 at the goal).
+std::vector<PathPoint> centerline_points(const PlanningContext& context, double s0, const RoadEnd& end);
 
 }  // namespace pullout

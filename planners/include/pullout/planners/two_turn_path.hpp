@@ -1,0 +1,39 @@
+// Two turns joined by a common tangent: the shape of both the geometric (arc turns) and the
+// clothoid (clothoid-arc-clothoid turns) pull-out. From a start pose, the first turn heads towards
+// the road, an optional straight follows, and the second turn brings the vehicle onto the road
+// centerline with the centerline's heading.
+//
+// The unknown is the first turn's heading change d1 (the second is what is left to reach the
+// centerline's heading). It is found as the root of the end point's lateral offset from the
+// centerline, bracketed from the two-arc closed form 2R(1 - cos d) + l sin d = offset when the
+// start is parallel to the road, or by scanning d1 otherwise, then refined with the Illinois
+// method on the exact path. Because the target heading depends on where the path ends (curved
+// roads), the solve is repeated with the heading at the previous end until it settles.
+#pragma once
+
+#include <optional>
+
+#include "pullout/geometry/curvature_path.hpp"
+#include "pullout/geometry/polyline.hpp"
+
+namespace pullout {
+
+struct TwoTurnSpec {
+  double kappa{0.2};      // [1/m] peak curvature of the turns
+  double sharpness{0.0};  // [1/m^2] curvature rate; <= 0: circular arcs
+  double straight{0.0};   // [m] common tangent between the turns
+};
+
+struct TwoTurnPath {
+  CurvaturePath path;
+  std::size_t first_turn_pieces{0};  // pieces of the first turn (the path splits after them)
+  double lateral_error{0.0};         // [m] end point to the centerline
+  double heading_error{0.0};         // [rad] end heading minus the centerline's
+};
+
+// `centerline` should be a local window of the road centerline around the start (projection is
+// linear in its size). nullopt when no root exists (the start is too close to the centerline for
+// these turns, or the turns cannot reach it going forward).
+std::optional<TwoTurnPath> solve_two_turn(const Pose2& start, const Polyline& centerline, const TwoTurnSpec& spec);
+
+}  // namespace pullout

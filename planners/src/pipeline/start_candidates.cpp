@@ -1,0 +1,81 @@
+#include "start_candidates.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pullout/collision/footprint.hpp"
+
+namespace pullout {
+
+namespace {
+
+// The pose `back` metres behind the vehicle on the line through it parallel to the pull-out
+// lanes' centerline, facing along the lanes.
+Pose2 backed_pose(const LaneChain& lanes, double s_ego, double lateral, double back) {
+  const Polyline& c = lanes.centerline;
+  const double s = s_ego - back;
+  const Pose2 base = c.pose_at(s);
+  const Vec2 p = to_vec(base) + left_normal(heading(base.yaw)) * lateral;
+  return {p.x(), p.y(), base.yaw};
+}
+
+}  // namespace
+
+StartCandidateSearch search_start_candidates(const PlanningContext& ctx, const Pose2& ego) {
+  const auto& p = ctx.parameters;
+  StartCandidateSearch out;
+  if (!p.enable_back) {
+    out.candidates.push_back({ego, 0.0});
+    return out;
+  }
+  const LaneChain& lanes = ctx.pull_out;
+  const auto proj = lanes.centerline.project(to_vec(ego));
+  const double allowed = std::clamp(proj.s - ctx.vehicle.base_to_rear_m(), 0.0, p.max_back_distance);
+  const double last_margin = p.collision_check_margins.back();
+  for (double back = 0.0; back <= allowed + 1e-9; back += p.backward_search_resolution) {
+    const Pose2 pose = back == 0.0 ? ego : backed_pose(lanes, proj.s, proj.lateral, back);
+    const std::string at = "start candidate " + format_fixed(back, 1) + " m back";
+    if (back > 0.0) {
+      const auto hit = ctx.objects.clearance(pose, last_margin);
+      if (hit.distance < last_margin) {
+        out.skipped.push_back(at + ": within " + format_fixed(last_margin, 2) + " m of object " +
+                              std::to_string(hit.obstacle_id) + ", search ends");
+        break;
+      }
+    }
+    const auto front = ctx.objects.clearance_ahead(pose, p.collision_check_margin_from_front_object);
+    if (front.distance < p.collision_check_margin_from_front_object) {
+      out.skipped.push_back(at + ": " + format_fixed(front.distance, 2) + " m from object " +
+                            std::to_string(front.obstacle_id) + " ahead (collision_check_margin_from_front_object " +
+                            format_fixed(p.collision_check_margin_from_front_object, 1) + " m)");
+      continue;
+    }
+    if (lanes.centerline.length() - (proj.s - back) < p.ignore_distance_from_lane_end) {
+      out.skipped.push_back(at + ": closer than ignore_distance_from_lane_end to the end of the lanes");
+      continue;
+    }
+    out.candidates.push_back({pose, back});
+  }
+  return out;
+}
+
+PathWithLaneId reverse_segment(const PlanningContext& ctx, const Pose2& ego, const StartCandidate& candidate) {
+  const auto& p = ctx.parameters;
+  const LaneChain& lanes = ctx.pull_out;
+  const auto proj = lanes.centerline.project(to_vec(ego));
+  PathWithLaneId seg;
+  const double step = p.center_line_path_interval;
+  const auto n = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(candidate.backward_distance / step - 1e-9)));
+  for (std::size_t i = 0; i <= n; ++i) {
+    const double back = candidate.backward_distance * static_cast<double>(i) / static_cast<double>(n);
+    PathPoint pt;
+    pt.pose = i == 0 ? ego : (i == n ? candidate.pose : backed_pose(lanes, proj.s, proj.lateral, back));
+    pt.longitudinal_velocity_mps = i == n ? 0.0 : p.backward_velocity;
+    const double s = proj.s - back;
+    pt.lane_ids = lane_ids_at(ctx, to_vec(pt.pose), ctx.world.lanes()[lanes.lanes[lanes.lane_at(s)]].id);
+    seg.points.push_back(std::move(pt));
+  }
+  return seg;
+}
+
+}  // namespace pullout

@@ -1,0 +1,62 @@
+// Shared pieces of the integration tests: a GoogleTest fixture that runs the real pullout_service
+// on a domain of its own and checks, after every test, that it stopped cleanly (exit status 0,
+// nothing left in /dev/shm); clients on that domain; scenario loading; path invariants.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pullout/client/client.hpp"
+#include "pullout/config/config.hpp"
+#include "pullout/config/scenario.hpp"
+#include "pullout/model/types.hpp"
+#include "service_process.hpp"
+
+namespace pullout::integration {
+
+// Bounds of the waits. Generous: the machine may be busy with builds; a healthy run takes a
+// fraction of each.
+constexpr std::chrono::seconds kMatchTimeout{15};
+constexpr std::chrono::seconds kReplyTimeout{10};
+
+std::string source_path(const std::string& relative);  // PULLOUT_SOURCE_DIR/relative
+std::string scenario_path(const std::string& name);    // tests/scenarios/<name>.yaml
+std::string default_config_path();                     // config/pullout.yaml
+std::string loopback_profiles_path();                  // config/dds/loopback.xml
+
+// The scenario on top of config/pullout.yaml (what the service plans with).
+Scenario load_test_scenario(const std::string& name);
+
+// Checks the invariants of a found PullOutPath (DESIGN.md): found, pairs == partial paths >= 1,
+// every partial path >= 2 finite points, constant driving direction inside a partial path,
+// consecutive partial paths join.
+void expect_found_path_invariants(const PullOutPath& path);
+
+class ServiceTest : public ::testing::Test {
+ protected:
+  void TearDown() override;
+
+  // Starts pullout_service with `config_path` (default: config/pullout.yaml); fails the test
+  // (fatal) when it does not become ready.
+  void start_service(const std::string& config_path = default_config_path());
+
+  // A client of `vehicle` on the service's domain, matched with the service (fatal failure when
+  // it does not match within kMatchTimeout). profiles_file empty: the client's built-in
+  // loopback defaults.
+  std::unique_ptr<Client> connect(const std::string& vehicle, const std::string& profiles_file = "");
+
+  int domain() const { return service_ ? service_->domain() : -1; }
+  ServiceProcess& service() { return *service_; }
+  std::string service_stderr() const { return service_ ? service_->stderr_tail() : ""; }
+
+  TempDir temp_;
+
+ private:
+  std::optional<ServiceProcess> service_;
+};
+
+}  // namespace pullout::integration
