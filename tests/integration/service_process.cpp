@@ -88,6 +88,8 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::stri
     ::dup2(err_fd, STDERR_FILENO);
     const int null_fd = ::open("/dev/null", O_RDONLY);
     if (null_fd >= 0) ::dup2(null_fd, STDIN_FILENO);
+    // Nothing else of the parent's (its DDS sockets above all) may live on in the child.
+    ::close_range(3, ~0U, 0);
     ::execv(c_argv[0], c_argv.data());
     static const char kExecFailed[] = "ChildProcess: execv failed\n";
     (void)!::write(STDERR_FILENO, kExecFailed, sizeof(kExecFailed) - 1);

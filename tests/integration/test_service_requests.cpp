@@ -162,13 +162,16 @@ TEST_F(PullOutFlow, BoxedInGivesAStopPathAndNoPathWithReasons) {
   // Every margin of the service's ladder was tried, each attempt recorded with its outcome.
   ASSERT_FALSE(status->evaluation_table.empty());
   std::set<double> margins;
+  std::ostringstream table;
   for (const PlannerAttempt& row : status->evaluation_table) {
     margins.insert(row.margin_m);
+    table << "\n  planner " << static_cast<int>(row.planner) << ", margin " << row.margin_m << " m, backward "
+          << row.backward_distance_m << " m: " << row.outcome;
     EXPECT_FALSE(row.outcome.empty());
     EXPECT_NE(row.outcome, "success");
   }
   const auto& ladder = scenario.parameters.collision_check_margins;
-  EXPECT_EQ(margins, std::set<double>(ladder.begin(), ladder.end()));
+  EXPECT_EQ(margins, std::set<double>(ladder.begin(), ladder.end())) << "evaluation table:" << table.str();
   EXPECT_EQ(margins.size(), 4u);
 }
 

@@ -22,6 +22,8 @@
 #include <thread>
 #include <vector>
 
+#include <fastcdr/Cdr.h>
+#include <fastcdr/FastBuffer.h>
 #include <gtest/gtest.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -165,6 +167,16 @@ class TestClient {
     participant_ = factory->create_participant_with_profile(domain, "pullout_participant");
     if (participant_ == nullptr) throw std::runtime_error("participant");
     auto* request_topic = topic("pullout/request", idl::make_guarded_type<msg::PullOutRequestPubSubType>());
+    // A second participant for the garbage writer: one participant registers one type per name.
+    garbage_participant_ = factory->create_participant_with_profile(domain, "pullout_participant");
+    if (garbage_participant_ == nullptr) throw std::runtime_error("participant");
+    dds::TypeSupport garbage_type(std::make_unique<GarbageRequestType>().release());
+    garbage_type.register_type(garbage_participant_);
+    auto* garbage_topic =
+        garbage_participant_->create_topic("pullout/request", garbage_type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    garbage_writer_ = garbage_participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT)
+                          ->create_datawriter_with_profile(garbage_topic, "pullout_request_writer");
+    if (garbage_writer_ == nullptr) throw std::runtime_error("garbage writer");
     auto* progress_topic = topic("pullout/progress", idl::make_guarded_type<msg::ExecutionProgressPubSubType>());
     auto* path_topic = topic("pullout/path", idl::make_guarded_type<msg::PullOutPathPubSubType>());
     auto* status_topic = topic("pullout/status", idl::make_guarded_type<msg::PullOutStatusPubSubType>());
@@ -182,6 +194,8 @@ class TestClient {
   }
 
   ~TestClient() {
+    garbage_participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(garbage_participant_);
     participant_->delete_contained_entities();
     dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
   }
@@ -205,6 +219,11 @@ class TestClient {
     return request_writer_->write(&m);
   }
   bool send(msg::PullOutRequest m) { return request_writer_->write(&m); }
+  bool send_garbage(const std::string& vehicle) {
+    msg::PullOutRequest m;
+    m.vehicle_id(vehicle);
+    return garbage_writer_->write(&m);
+  }
   bool send(const ExecutionProgress& p) {
     msg::ExecutionProgress m = idl::to_msg(p);
     return progress_writer_->write(&m);
@@ -230,8 +249,31 @@ class TestClient {
   }
 
   dds::DomainParticipant* participant_{nullptr};
+  dds::DomainParticipant* garbage_participant_{nullptr};
+  dds::DataWriter* garbage_writer_{nullptr};
   dds::DataWriter* request_writer_{nullptr};
   dds::DataWriter* progress_writer_{nullptr};
+};
+
+// Writes PullOutRequest samples whose `lanes` sequence claims 2^31 - 1 elements and then ends: a
+// reader that trusted the length would try to allocate hundreds of GB.
+class GarbageRequestType : public msg::PullOutRequestPubSubType {
+ public:
+  bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
+    const auto* request = static_cast<msg::PullOutRequest*>(data);
+    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->max_size);
+    eprosima::fastcdr::Cdr ser(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN, eprosima::fastcdr::Cdr::DDS_CDR);
+    payload->encapsulation = ser.endianness() == eprosima::fastcdr::Cdr::BIG_ENDIANNESS ? CDR_BE : CDR_LE;
+    ser.serialize_encapsulation();
+    ser << request->vehicle_id() << request->request_id() << request->stamp().sec() << request->stamp().nanosec();
+    for (int i = 0; i < 7 + 1 + 7; ++i) ser << (i == 6 || i == 14 ? 1.0 : 0.0);  // ego pose, velocity, goal pose
+    ser << static_cast<std::uint32_t>(0x7FFFFFFF);                               // lanes: "2^31 - 1 elements"
+    payload->length = static_cast<std::uint32_t>(ser.getSerializedDataLength());
+    return true;
+  }
+  std::function<std::uint32_t()> getSerializedSizeProvider(void*) override {
+    return [] { return 1024u; };
+  }
 };
 
 PullOutRequest scenario_request(const std::string& name, const std::string& vehicle, std::uint64_t request_id) {
@@ -381,6 +423,18 @@ TEST_F(ServiceDds, MalformedRequestIsRejectedNamingTheField) {
   const auto good = client_->final_status("bad-1", 42);
   ASSERT_TRUE(good.has_value());
   EXPECT_EQ(good->state, ExecutionState::kExecuting);
+}
+
+TEST_F(ServiceDds, UndecodableSampleIsDroppedAndTheServiceGoesOn) {
+  // Wait until the garbage writer is matched too, so that the sample is really delivered.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_TRUE(client_->send_garbage("garbage-1"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ASSERT_TRUE(service_->running());
+  ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "garbage-1", 45)));
+  const auto status = client_->final_status("garbage-1", 45);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->state, ExecutionState::kExecuting);
 }
 
 TEST_F(ServiceDds, CoreValidationRejectsAnInconsistentRequest) {

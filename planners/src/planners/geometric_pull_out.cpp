@@ -39,8 +39,12 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
                           pieces.front().k0 * pieces.back().k0 < 0.0;
     const bool divide = p.divide_pull_out_path && s_shaped;
     const std::size_t first_turn = turns->first_turn_pieces;
-    const double a_max = p.maximum_longitudinal_acc;
-    auto segment = [divide, first_turn, v, a_max](const std::vector<Pose2>& pts, const std::vector<std::size_t>& junctions) {
+    double first_turn_length = 0.0;
+    for (std::size_t i = 0; i < first_turn; ++i) first_turn_length += pieces[i].length;
+    // A short first arc cannot reach v comfortably before stopping: cruise at what
+    // maximum_longitudinal_acc reaches over half of it.
+    const double v1 = divide ? std::min(v, std::sqrt(p.maximum_longitudinal_acc * first_turn_length)) : v;
+    auto segment = [divide, first_turn, v, v1](const std::vector<Pose2>& pts, const std::vector<std::size_t>& junctions) {
       TurnSegmentation seg;
       const auto length_between = [&pts](std::size_t a, std::size_t b) {
         double len = 0.0;
@@ -53,9 +57,6 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
         const double l1 = length_between(0, split);
         const double l2 = length_between(split, last);
         seg.splits = {split};
-        // A short first arc cannot reach v comfortably before stopping: cruise at what
-        // maximum_longitudinal_acc reaches over half of it.
-        const double v1 = std::min(v, std::sqrt(a_max * l1));
         seg.pairs = {{v1, v1 * v1 / l1}, {v, v * v / (2.0 * l2)}};
       } else {
         seg.pairs = {{v, v * v / (2.0 * length_between(0, last))}};
@@ -67,7 +68,10 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
     options.departure_expansion = p.lane_departure_margin;
     options.collision_distance_from_end = p.geometric_collision_check_distance_from_end;
     options.output_interval = p.arc_path_interval;
-    out.candidates.push_back(make_turn_candidate(ctx, *turns, options, [v](double) { return v; }, segment));
+    const auto velocity = [divide, first_turn_length, v, v1](double d) {
+      return divide && d < 0.99 * first_turn_length ? v1 : v;  // chords are shorter than arcs
+    };
+    out.candidates.push_back(make_turn_candidate(ctx, *turns, options, velocity, segment));
   }
   return out;
 }
