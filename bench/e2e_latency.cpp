@@ -416,13 +416,14 @@ int run_bench(int requests, int warmup, int pings, int plans) {
   print_row("DDS round trip, request-sized ping / reply-sized pong", asym_s);
   std::printf("\n");
   const double floor = plan_s.p50 + asym_s.p50;
-  std::printf("e2e p50 %.3f ms vs floor %.3f ms (planning p50 %.3f + round trip p50 %.3f, request-sized ping /"
-              " reply-sized pong): overhead %.3f ms\n",
-              e2e_s.p50, floor, plan_s.p50, asym_s.p50, e2e_s.p50 - floor);
+  std::printf(
+      "e2e p50 %.3f ms vs floor %.3f ms (planning p50 %.3f + round trip p50 %.3f, request-sized ping /"
+      " reply-sized pong): overhead %.3f ms\n",
+      e2e_s.p50, floor, plan_s.p50, asym_s.p50, e2e_s.p50 - floor);
   std::printf("with the reply-sized round trip both ways: floor %.3f ms, overhead %.3f ms\n", plan_s.p50 + sym_s.p50,
               e2e_s.p50 - plan_s.p50 - sym_s.p50);
-  std::printf("lost: e2e %zu, ping-pong %zu; service %s, %zu file(s) left in /dev/shm; echo %s\n", e2e.lost,
-              ping.lost, service_report.exit.describe().c_str(), service_report.leaked_shm_files.size(),
+  std::printf("lost: e2e %zu, ping-pong %zu; service %s, %zu file(s) left in /dev/shm; echo %s\n", e2e.lost, ping.lost,
+              service_report.exit.describe().c_str(), service_report.leaked_shm_files.size(),
               echo_exit.describe().c_str());
   const bool clean = e2e.lost == 0 && ping.lost == 0 && service_report.clean() && echo_exit.clean();
   return clean ? 0 : 1;
@@ -430,7 +431,9 @@ int run_bench(int requests, int warmup, int pings, int plans) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   CLI::App app{"bench_e2e: end-to-end latency of pullout_service over loopback DDS, with its floors"};
   int requests = 200;
   int warmup = 20;
@@ -446,8 +449,11 @@ int main(int argc, char** argv) {
   app.add_flag("--echo", echo, "internal: run as the ping-pong echo process");
   app.add_option("--domain", domain, "internal (--echo): DDS domain")->check(CLI::Range(0, 232));
   app.add_option("--profiles", profiles, "internal (--echo): DDS profiles file");
-  CLI11_PARSE(app, argc, argv);
-
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
   if (echo) {
     if (domain < 0) {
       std::fprintf(stderr, "bench_e2e: --echo needs --domain\n");
@@ -455,8 +461,16 @@ int main(int argc, char** argv) {
     }
     return run_echo(domain, profiles);
   }
+  return run_bench(requests, warmup, pings, plans);
+}
+
+}  // namespace
+
+// Exit codes: 0 a clean run, 1 a run with lost replies or an unclean child exit (or bad usage),
+// 2 the benchmark could not run.
+int main(int argc, char** argv) {
   try {
-    return run_bench(requests, warmup, pings, plans);
+    return run(argc, argv);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_e2e: %s\n", e.what());
     return 2;

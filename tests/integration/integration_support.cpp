@@ -65,8 +65,7 @@ std::unique_ptr<Client> ServiceTest::connect(const std::string& vehicle, const s
   options.profiles_file = profiles_file;
   auto client = std::make_unique<Client>(options);
   if (!client->wait_for_service(kMatchTimeout)) {
-    ADD_FAILURE() << "client '" << vehicle << "' did not match the service within " << kMatchTimeout.count()
-                  << " s";
+    ADD_FAILURE() << "client '" << vehicle << "' did not match the service within " << kMatchTimeout.count() << " s";
     return nullptr;
   }
   return client;

@@ -65,6 +65,7 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::stri
   // process may only make async-signal-safe calls.
   std::vector<std::string> args = argv;
   std::vector<char*> c_argv;
+  c_argv.reserve(args.size() + 1);
   for (auto& a : args) c_argv.push_back(a.data());
   c_argv.push_back(nullptr);
   const int out_fd = ::open(stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -171,8 +172,8 @@ DomainLease::DomainLease(int first, int last) {
     }
     ::close(fd);
   }
-  throw std::runtime_error("DomainLease: every DDS domain in [" + std::to_string(first) + ", " +
-                           std::to_string(last) + "] is in use");
+  throw std::runtime_error("DomainLease: every DDS domain in [" + std::to_string(first) + ", " + std::to_string(last) +
+                           "] is in use");
 }
 
 DomainLease::~DomainLease() {
@@ -196,7 +197,7 @@ TempDir::~TempDir() {
 }
 
 std::string TempDir::write_file(const std::string& name, const std::string& text) const {
-  const std::string file = path_ + "/" + name;
+  std::string file = path_ + "/" + name;
   std::ofstream out(file, std::ios::trunc);
   out << text;
   out.close();

@@ -28,7 +28,7 @@ using Millis = std::chrono::milliseconds;
 
 // How a child ended.
 struct ExitResult {
-  bool exited{false};        // normal exit: exit_code is valid
+  bool exited{false};  // normal exit: exit_code is valid
   int exit_code{-1};
   int signal{0};             // killed by this signal (exited == false)
   bool force_killed{false};  // did not stop within the timeout and was sent SIGKILL
@@ -43,8 +43,7 @@ class ChildProcess {
   // files (truncated). The child gets SIGTERM if the thread that started it dies first
   // (PR_SET_PDEATHSIG), so a crashed or timed-out test does not leave it running: start children
   // from a thread that outlives them (the main thread). Throws std::runtime_error.
-  ChildProcess(const std::vector<std::string>& argv, const std::string& stdout_path,
-               const std::string& stderr_path);
+  ChildProcess(const std::vector<std::string>& argv, const std::string& stdout_path, const std::string& stderr_path);
   ~ChildProcess();  // stop(kDefaultStopTimeout) if still running; never throws
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;

@@ -7,13 +7,13 @@
 #include <string>
 #include <thread>
 
+#include <gtest/gtest.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-#include <gtest/gtest.h>
 
 #include "integration_support.hpp"
 #include "pullout/idl/convert.hpp"

@@ -50,9 +50,8 @@ TEST_F(PullOutFlow, StraightShoulderIsPlannedAndExecutedToCompletion) {
   ASSERT_EQ(path->partial_paths.size(), 1u);
   EXPECT_EQ(path->planner_type, PlannerType::kShift);
 
-  const auto executing =
-      client->wait_for_status(id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); },
-                              kReplyTimeout);
+  const auto executing = client->wait_for_status(
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
   ASSERT_TRUE(executing) << "latest status: "
                          << (client->latest_status() ? static_cast<int>(client->latest_status()->state) : -1);
   EXPECT_EQ(executing->current_path_idx, 0u);
@@ -89,9 +88,8 @@ TEST_F(PullOutFlow, StraightShoulderIsPlannedAndExecutedToCompletion) {
   }
   ASSERT_TRUE(past_end) << "the path never passes its own end_pose";
 
-  const auto completed =
-      client->wait_for_status(id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kCompleted); },
-                              kReplyTimeout);
+  const auto completed = client->wait_for_status(
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kCompleted); }, kReplyTimeout);
   ASSERT_TRUE(completed) << "no COMPLETED status after driving past end_pose";
   EXPECT_EQ(completed->current_path_idx, 0u);
   EXPECT_EQ(completed->segment_count, 1u);
@@ -185,18 +183,18 @@ TEST_F(PullOutFlow, FiveThousandPointPathArrives) {
                                               "dds:\n"
                                               "  profiles_file: " +
                                                   loopback_profiles_path() + "\n");
-  const std::string scenario_file = temp_.write_file(
-      "long_road_scenario.yaml",
-      "description: \"6 km straight road, goal 5.8 km ahead: a path of more than 5,000 points\"\n"
-      "lanes:\n"
-      "  - {id: 1, subtype: road, speed_limit: 13.89,\n"
-      "     left_bound: [[0, 1.75], [6000, 1.75]], right_bound: [[0, -1.75], [6000, -1.75]]}\n"
-      "  - {id: 2, subtype: road_shoulder, speed_limit: 13.89,\n"
-      "     left_bound: [[0, 4.75], [6000, 4.75]], right_bound: [[0, 1.75], [6000, 1.75]]}\n"
-      "start: {x: 10.0, y: 3.25, yaw_deg: 0.0}\n"
-      "goal: {x: 5810.0, y: 0.0, yaw_deg: 0.0}\n"
-      "planner: {forward_path_length: 6000.0, center_line_path_interval: 1.0}\n"
-      "deadline_ms: 5000\n");
+  const std::string scenario_file =
+      temp_.write_file("long_road_scenario.yaml",
+                       "description: \"6 km straight road, goal 5.8 km ahead: a path of more than 5,000 points\"\n"
+                       "lanes:\n"
+                       "  - {id: 1, subtype: road, speed_limit: 13.89,\n"
+                       "     left_bound: [[0, 1.75], [6000, 1.75]], right_bound: [[0, -1.75], [6000, -1.75]]}\n"
+                       "  - {id: 2, subtype: road_shoulder, speed_limit: 13.89,\n"
+                       "     left_bound: [[0, 4.75], [6000, 4.75]], right_bound: [[0, 1.75], [6000, 1.75]]}\n"
+                       "start: {x: 10.0, y: 3.25, yaw_deg: 0.0}\n"
+                       "goal: {x: 5810.0, y: 0.0, yaw_deg: 0.0}\n"
+                       "planner: {forward_path_length: 6000.0, center_line_path_interval: 1.0}\n"
+                       "deadline_ms: 5000\n");
   start_service(config);
   const Scenario scenario = load_scenario(scenario_file, load_config(config));
   auto client = connect("int-long-road");
@@ -212,8 +210,8 @@ TEST_F(PullOutFlow, FiveThousandPointPathArrives) {
   std::size_t points = 0;
   for (const auto& segment : path->partial_paths) points += segment.points.size();
   EXPECT_GE(points, 5000u);
-  EXPECT_LT(elapsed, kBound) << "took "
-                             << std::chrono::duration_cast<std::chrono::milliseconds>(elapsed).count() << " ms";
+  EXPECT_LT(elapsed, kBound) << "took " << std::chrono::duration_cast<std::chrono::milliseconds>(elapsed).count()
+                             << " ms";
   const auto status = client->wait_for_status(
       id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
   ASSERT_TRUE(status);
@@ -227,6 +225,7 @@ TEST_F(PullOutFlow, TwentyVehiclesAtOnceAreAllServed) {
   const Scenario scenario = load_test_scenario("straight_shoulder");
 
   std::vector<std::unique_ptr<Client>> clients;
+  clients.reserve(kVehicles);
   for (int i = 0; i < kVehicles; ++i) {
     ClientOptions options;
     options.vehicle_id = "int-fleet-" + std::to_string(i);
@@ -246,6 +245,7 @@ TEST_F(PullOutFlow, TwentyVehiclesAtOnceAreAllServed) {
   std::vector<std::uint64_t> ids(kVehicles, 0);
   std::vector<std::string> errors(kVehicles);
   std::vector<std::thread> threads;
+  threads.reserve(kVehicles);
   const auto start = SteadyClock::now();
   for (int i = 0; i < kVehicles; ++i) {
     threads.emplace_back([&, i] {

@@ -159,6 +159,27 @@ class Inbox {
   std::vector<Model> samples_;
 };
 
+// Writes PullOutRequest samples whose `lanes` sequence claims 2^31 - 1 elements and then ends: a
+// reader that trusted the length would try to allocate hundreds of GB.
+class GarbageRequestType : public msg::PullOutRequestPubSubType {
+ public:
+  bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
+    const auto* request = static_cast<msg::PullOutRequest*>(data);
+    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->max_size);
+    eprosima::fastcdr::Cdr ser(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN, eprosima::fastcdr::Cdr::DDS_CDR);
+    payload->encapsulation = ser.endianness() == eprosima::fastcdr::Cdr::BIG_ENDIANNESS ? CDR_BE : CDR_LE;
+    ser.serialize_encapsulation();
+    ser << request->vehicle_id() << request->request_id() << request->stamp().sec() << request->stamp().nanosec();
+    for (int i = 0; i < 7 + 1 + 7; ++i) ser << (i == 6 || i == 14 ? 1.0 : 0.0);  // ego pose, velocity, goal pose
+    ser << static_cast<std::uint32_t>(0x7FFFFFFF);                               // lanes: "2^31 - 1 elements"
+    payload->length = static_cast<std::uint32_t>(ser.getSerializedDataLength());
+    return true;
+  }
+  std::function<std::uint32_t()> getSerializedSizeProvider(void*) override {
+    return [] { return 1024u; };
+  }
+};
+
 class TestClient {
  public:
   explicit TestClient(int domain) {
@@ -253,27 +274,6 @@ class TestClient {
   dds::DataWriter* garbage_writer_{nullptr};
   dds::DataWriter* request_writer_{nullptr};
   dds::DataWriter* progress_writer_{nullptr};
-};
-
-// Writes PullOutRequest samples whose `lanes` sequence claims 2^31 - 1 elements and then ends: a
-// reader that trusted the length would try to allocate hundreds of GB.
-class GarbageRequestType : public msg::PullOutRequestPubSubType {
- public:
-  bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
-    const auto* request = static_cast<msg::PullOutRequest*>(data);
-    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->max_size);
-    eprosima::fastcdr::Cdr ser(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN, eprosima::fastcdr::Cdr::DDS_CDR);
-    payload->encapsulation = ser.endianness() == eprosima::fastcdr::Cdr::BIG_ENDIANNESS ? CDR_BE : CDR_LE;
-    ser.serialize_encapsulation();
-    ser << request->vehicle_id() << request->request_id() << request->stamp().sec() << request->stamp().nanosec();
-    for (int i = 0; i < 7 + 1 + 7; ++i) ser << (i == 6 || i == 14 ? 1.0 : 0.0);  // ego pose, velocity, goal pose
-    ser << static_cast<std::uint32_t>(0x7FFFFFFF);                               // lanes: "2^31 - 1 elements"
-    payload->length = static_cast<std::uint32_t>(ser.getSerializedDataLength());
-    return true;
-  }
-  std::function<std::uint32_t()> getSerializedSizeProvider(void*) override {
-    return [] { return 1024u; };
-  }
 };
 
 PullOutRequest scenario_request(const std::string& name, const std::string& vehicle, std::uint64_t request_id) {

@@ -7,6 +7,10 @@
 namespace pullout {
 
 double normalize_angle(double angle) {
+  // Most angles are already in range or one turn off: avoid fmod for them.
+  if (angle >= -M_PI && angle < M_PI) return angle;
+  if (angle >= M_PI && angle < 3.0 * M_PI) return angle - 2.0 * M_PI;
+  if (angle < -M_PI && angle >= -3.0 * M_PI) return angle + 2.0 * M_PI;
   double a = std::fmod(angle + M_PI, 2.0 * M_PI);
   if (a < 0.0) a += 2.0 * M_PI;
   return a - M_PI;
@@ -85,6 +89,22 @@ Pose2 Polyline::pose_at(double s) const {
   return {p.x(), p.y(), yaw_at(s)};
 }
 
+Polyline::Sample Polyline::sample_at(double s) const {
+  Sample out;
+  if (points_.size() < 2) {
+    if (!points_.empty()) out.pose = {points_[0].x(), points_[0].y(), 0.0};
+    return out;
+  }
+  const std::size_t i = segment_at(s);
+  const double len = s_[i + 1] - s_[i];
+  const double t_raw = (s - s_[i]) / len;
+  const double t = std::clamp(t_raw, 0.0, 1.0);
+  const Vec2 p = points_[i] + t_raw * (points_[i + 1] - points_[i]);
+  out.pose = {p.x(), p.y(), normalize_angle(vertex_yaw_[i] + t * normalize_angle(vertex_yaw_[i + 1] - vertex_yaw_[i]))};
+  out.curvature = vertex_curvature_[i] + t * (vertex_curvature_[i + 1] - vertex_curvature_[i]);
+  return out;
+}
+
 double Polyline::curvature_at(double s) const {
   if (points_.size() < 3) return 0.0;
   const std::size_t i = segment_at(s);
@@ -94,27 +114,32 @@ double Polyline::curvature_at(double s) const {
 
 Polyline::Projection Polyline::project(const Vec2& p) const {
   Projection best;
-  best.distance = std::numeric_limits<double>::infinity();
+  double best_d2 = std::numeric_limits<double>::infinity();
   const std::size_t n = points_.size();
   for (std::size_t i = 0; i + 1 < n; ++i) {
     const Vec2 a = points_[i];
     const Vec2 d = points_[i + 1] - a;
     const double len2 = d.squaredNorm();
-    const double t_raw = (p - a).dot(d) / len2;
-    const double t = std::clamp(t_raw, 0.0, 1.0);
-    const double dist = (a + t * d - p).norm();
-    if (dist < best.distance) {
-      best.distance = dist;
+    const double t = std::clamp((p - a).dot(d) / len2, 0.0, 1.0);
+    const double d2 = (a + t * d - p).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
       best.segment = i;
-      // Beyond the first/last vertex the end segment is extended, so that s and the lateral
-      // offset stay meaningful for points just outside the line.
-      const bool extrapolate = (i == 0 && t_raw < 0.0) || (i + 2 == n && t_raw > 1.0);
-      const double tt = extrapolate ? t_raw : t;
-      const double len = std::sqrt(len2);
-      best.s = s_[i] + tt * len;
-      best.lateral = (d.x() * (p - a).y() - d.y() * (p - a).x()) / len;
     }
   }
+  if (n < 2) return best;
+  const std::size_t i = best.segment;
+  const Vec2 a = points_[i];
+  const Vec2 d = points_[i + 1] - a;
+  const double len = d.norm();
+  const double t_raw = (p - a).dot(d) / (len * len);
+  // Beyond the first/last vertex the end segment is extended, so that s and the lateral offset
+  // stay meaningful for points just outside the line.
+  const bool extrapolate = (i == 0 && t_raw < 0.0) || (i + 2 == n && t_raw > 1.0);
+  const double t = extrapolate ? t_raw : std::clamp(t_raw, 0.0, 1.0);
+  best.distance = std::sqrt(best_d2);
+  best.s = s_[i] + t * len;
+  best.lateral = (d.x() * (p - a).y() - d.y() * (p - a).x()) / len;
   return best;
 }
 

@@ -110,23 +110,24 @@ ObjectChecker::Clearance section_clearance(const PlanningContext& ctx, const std
 
 void check_candidate(const PlanningContext& ctx, const std::vector<Pose2>& poses, const CandidateChecks& checks,
                      PathCandidate& candidate) {
-  const std::size_t section_last = checks.section_last;
-  const std::size_t contact_last = checks.contact_last;
-  if (checks.check_lanes) {
-    if (first_lane_departure(ctx, poses, 0, checks.departure_last, checks.expansion)) {
-      candidate.rejection = "lane departure";
-      return;
-    }
-  }
-  const auto c = section_clearance(ctx, poses, 0, section_last);
+  // Obstacles first: a candidate in contact is rejected whatever the lanes say, and finding the
+  // contact stops early, while the lane check of a good candidate has to look at every pose.
+  const auto c = section_clearance(ctx, poses, 0, checks.section_last);
   candidate.clearance = c.distance;
   candidate.nearest_obstacle = c.obstacle_id;
-  for (std::size_t i = section_last + 1; i <= contact_last && i < poses.size(); ++i) {
+  if (c.distance < kTouchingDistance) {
+    candidate.rejection = "collision with object " + std::to_string(c.obstacle_id);
+    return;
+  }
+  for (std::size_t i = checks.section_last + 1; i <= checks.contact_last && i < poses.size(); ++i) {
     const auto hit = ctx.objects.clearance(poses[i], kTouchingDistance);
     if (hit.distance < kTouchingDistance) {
       candidate.rejection = "collision with object " + std::to_string(hit.obstacle_id) + " near the end pose";
       return;
     }
+  }
+  if (checks.check_lanes && first_lane_departure(ctx, poses, 0, checks.departure_last, checks.expansion)) {
+    candidate.rejection = "lane departure";
   }
 }
 

@@ -69,9 +69,10 @@ class ShiftShape {
 };
 
 Pose2 shifted_pose(const Polyline& center, double s, const Offset& o) {
-  const Vec2 base = center.point_at(s);
-  const double yaw_c = center.yaw_at(s);
-  const double k = center.curvature_at(s);
+  const Polyline::Sample c = center.sample_at(s);
+  const Vec2 base = to_vec(c.pose);
+  const double yaw_c = c.pose.yaw;
+  const double k = c.curvature;
   const Vec2 p = base + left_normal(heading(yaw_c)) * o.l;
   // Tangent of base + n(s) l(s): t (1 - k l) + n l'.
   return {p.x(), p.y(), normalize_angle(yaw_c + std::atan2(o.dl, 1.0 - k * o.l))};
@@ -97,11 +98,11 @@ struct Candidate {
   std::size_t shift_end_index{0};
 };
 
-// Samples the shifted centerline from s_start to the path end every center_line_path_interval,
-// with the shift end included exactly. Only poses: the path points (lane ids, velocities) are
-// built for the winning candidate alone.
-Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, double s_start, const RoadEnd& end) {
-  const Polyline& center = ctx.road.centerline;
+// Arc lengths from s_start to the path end every center_line_path_interval, with the shift end
+// included exactly; poses for those up to `s_poses_until` only (the checks need no more; the
+// winner gets the rest in extend_poses).
+Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, double s_start, const RoadEnd& end,
+                       double s_poses_until) {
   const double step = ctx.parameters.center_line_path_interval;
   Candidate c;
   for (double s = s_start; s < end.s - 1e-6; s += step) c.s.push_back(s);
@@ -112,12 +113,19 @@ Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, doub
       c.s.insert(it, shape.end());
     }
   }
-  c.poses.reserve(c.s.size());
   for (std::size_t i = 0; i < c.s.size(); ++i) {
-    c.poses.push_back(shifted_pose(center, c.s[i], shape.at(c.s[i])));
     if (c.s[i] <= shape.end() + 1e-9) c.shift_end_index = i;
   }
+  c.poses.reserve(c.s.size());
+  for (std::size_t i = 0; i < c.s.size() && (i == 0 || c.s[i] <= s_poses_until + 1e-9); ++i) {
+    c.poses.push_back(shifted_pose(ctx.road.centerline, c.s[i], shape.at(c.s[i])));
+  }
   return c;
+}
+
+// Beyond the shift the path is the centerline itself.
+void extend_poses(const PlanningContext& ctx, Candidate& c) {
+  for (std::size_t i = c.poses.size(); i < c.s.size(); ++i) c.poses.push_back(ctx.road.centerline.pose_at(c.s[i]));
 }
 
 // Velocities: capped at v_term up to the shift end, the lane speed limit after it, 0 at the goal.
@@ -264,9 +272,10 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
     } else {
       shape.emplace(k.profile, 0.0, s_start, 0.0);
     }
-    auto c = std::make_shared<const Candidate>(sample_poses(ctx, *shape, s_start, end));
     // Collision section: from the start to end_pose + shift_collision_check_distance_from_end.
     const double s_check_end = shape->end() + params.shift_collision_check_distance_from_end;
+    auto c = std::make_shared<Candidate>(
+        sample_poses(ctx, *shape, s_start, end, std::max(shape->end(), s_check_end)));
     std::size_t section_last = 0;
     while (section_last + 1 < c->s.size() && c->s[section_last + 1] <= s_check_end) ++section_last;
     check_candidate(ctx, c->poses,
@@ -274,6 +283,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
                      std::max(section_last, c->shift_end_index)},
                     candidate);
     candidate.build = [&ctx, c, end, k, shift_length]() {
+      extend_poses(ctx, *c);
       PullOutPath path;
       path.start_pose = c->poses.front();
       path.end_pose = c->poses[c->shift_end_index];

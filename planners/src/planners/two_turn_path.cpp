@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 
 namespace pullout {
 
@@ -53,7 +52,8 @@ std::optional<double> arc_s_curve_angle(double offset, double radius, double str
 }
 
 // Illinois (modified regula falsi) on [a, b] with f(a), f(b) of opposite signs.
-std::optional<double> refine(const std::function<double(double)>& f, double a, double fa, double b, double fb) {
+template <typename F>
+std::optional<double> refine(const F& f, double a, double fa, double b, double fb) {
   int side = 0;
   for (int i = 0; i < kMaxRootIterations; ++i) {
     const double c = (a * fb - b * fa) / (fb - fa);

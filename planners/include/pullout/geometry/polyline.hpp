@@ -48,6 +48,12 @@ class Polyline {
   // Heading [rad] at s, interpolated between vertex headings (clamped to the line).
   double yaw_at(double s) const;
   Pose2 pose_at(double s) const;
+  // pose_at and curvature_at with one segment lookup.
+  struct Sample {
+    Pose2 pose;
+    double curvature{0.0};
+  };
+  Sample sample_at(double s) const;
   // Signed curvature [1/m] at s, interpolated between vertex curvatures (Menger curvature of each
   // vertex with its neighbours; 0 at the end points).
   double curvature_at(double s) const;

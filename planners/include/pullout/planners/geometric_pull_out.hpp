@@ -5,7 +5,7 @@
 // Candidates, tightest first: tangent lengths 0, 1, ..., 9 m (Autoware moves the end pose by the
 // same offsets and recomputes one radius; a common tangent keeps both arcs at R and so the
 // curvature within 1/R everywhere). Lane departure: the footprint, expanded by
-// lane_departure_margin, must stay inside the lanes over the arcs, checked every 0.25 m.
+// lane_departure_margin, must stay inside the lanes over the arcs, checked every 0.5 m.
 //
 // divide_pull_out_path = true: two partial paths, split at the end of the first arc where the
 // vehicle stops to re-steer, when the arcs turn opposite ways (an S); false, or two arcs turning
