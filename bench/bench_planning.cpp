@@ -31,17 +31,27 @@ void plan_scenario(benchmark::State& state, const std::string& name) {
 
 // Nothing in the way: the first (gentlest) candidate at the first margin wins.
 void BM_Plan_StraightShoulder(benchmark::State& state) { plan_scenario(state, "straight_shoulder"); }
-// Straight shoulder with every margin of the ladder run: 4 margins x 4 shift candidates, the
-// last one succeeding (the car parked ahead only clears at 0.1 m).
+// Straight shoulder with every margin of the ladder run (shift only, no reversing): 4 margins x
+// 4 shift candidates, the last one succeeding (the car parked ahead only clears at 0.1 m).
 void BM_Plan_StraightShoulder_AllMargins(benchmark::State& state) { plan_scenario(state, "parked_car_ahead"); }
-// Everything fails: 4 margins x 4 candidates, then the stop path.
+// Boxed in: no start candidate survives the backward search, stop path.
 void BM_Plan_BoxedIn(benchmark::State& state) { plan_scenario(state, "boxed_in"); }
 void BM_Plan_CurvedRoad(benchmark::State& state) { plan_scenario(state, "curved_road"); }
+// The worst case of the lane-based search: 4 margins x 11 start candidates x {shift, geometric,
+// clothoid}, every attempt failing (132 evaluation rows).
+void BM_Plan_FullSearch(benchmark::State& state) { plan_scenario(state, "full_search"); }
+void BM_Plan_ParallelSpot(benchmark::State& state) { plan_scenario(state, "parallel_spot"); }
+void BM_Plan_PerpendicularBay(benchmark::State& state) { plan_scenario(state, "perpendicular_bay"); }
+void BM_Plan_CarCloseAhead(benchmark::State& state) { plan_scenario(state, "car_close_ahead"); }
 
 BENCHMARK(BM_Plan_StraightShoulder)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_StraightShoulder_AllMargins)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_BoxedIn)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_CurvedRoad)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_FullSearch)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_ParallelSpot)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_PerpendicularBay)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_CarCloseAhead)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -88,8 +88,23 @@ TEST_F(PullOutFlow, StraightShoulderIsPlannedAndExecutedToCompletion) {
   }
   ASSERT_TRUE(past_end) << "the path never passes its own end_pose";
 
-  const auto completed = client->wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kCompleted); }, kReplyTimeout);
+  // The vehicle stands at the last point and keeps reporting, as odometry does. (Progress is
+  // volatile, and Client::wait_for_service does not wait for the progress writer to match: the
+  // first samples may precede the match.)
+  std::optional<PullOutStatus> completed;
+  const auto give_up = SteadyClock::now() + kReplyTimeout;
+  while (!completed && SteadyClock::now() < give_up) {
+    completed = client->wait_for_status(
+        id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kCompleted); }, 100ms);
+    if (completed) break;
+    stamp_ns += 100'000'000;
+    ExecutionProgress standing;
+    standing.request_id = id;
+    standing.stamp_ns = stamp_ns;
+    standing.pose = points.back().pose;
+    standing.velocity_mps = 0.0;
+    client->report_progress(standing);
+  }
   ASSERT_TRUE(completed) << "no COMPLETED status after driving past end_pose";
   EXPECT_EQ(completed->current_path_idx, 0u);
   EXPECT_EQ(completed->segment_count, 1u);

@@ -38,6 +38,7 @@
 #include "pullout/idl/convert.hpp"
 #include "pullout/idl/guarded_type.hpp"
 #include "pullout/model/names.hpp"
+#include "service_process.hpp"  // DomainLease
 
 namespace pullout {
 namespace {
@@ -51,12 +52,9 @@ const std::string kServiceBinary = PULLOUT_SERVICE_BIN;
 const std::string kProfiles = kSourceDir + "/config/dds/loopback.xml";
 constexpr auto kReplyTimeout = std::chrono::seconds(10);
 
-// A domain of this test process's own, so that parallel test runs do not talk to each other.
-int test_domain() { return 100 + static_cast<int>(::getpid() % 100); }
-
 // ---- the service process -----------------------------------------------------------------------
 
-class ServiceProcess {
+class ServiceChild {
  public:
   void start(int domain) {
     const std::string config = kSourceDir + "/config/pullout.yaml";
@@ -112,7 +110,7 @@ class ServiceProcess {
     return false;
   }
 
-  ~ServiceProcess() { stop(std::chrono::milliseconds(2000)); }
+  ~ServiceChild() { stop(std::chrono::milliseconds(2000)); }
 
  private:
   pid_t pid_{0};
@@ -241,6 +239,12 @@ class TestClient {
   }
   bool send(msg::PullOutRequest m) { return request_writer_->write(&m); }
   bool send_garbage(const std::string& vehicle) {
+    const auto until = Clock::now() + std::chrono::seconds(10);
+    dds::PublicationMatchedStatus matched;
+    while (garbage_writer_->get_publication_matched_status(matched), matched.current_count < 1) {
+      if (Clock::now() > until) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
     msg::PullOutRequest m;
     m.vehicle_id(vehicle);
     return garbage_writer_->write(&m);
@@ -288,26 +292,32 @@ PullOutRequest scenario_request(const std::string& name, const std::string& vehi
 class ServiceDds : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    service_ = std::make_unique<ServiceProcess>();
-    service_->start(test_domain());
-    client_ = std::make_unique<TestClient>(test_domain());
+    service_ = std::make_unique<ServiceChild>();
+    // A domain of this test process's own (shared lease with tests/integration), so that tests run
+    // in parallel never talk to each other's service.
+    domain_ = std::make_unique<integration::DomainLease>();
+    service_->start(domain_->domain());
+    client_ = std::make_unique<TestClient>(domain_->domain());
     matched_ = client_->wait_matched();
   }
   static void TearDownTestSuite() {
     client_.reset();
     service_.reset();
+    domain_.reset();
   }
   void SetUp() override {
-    ASSERT_TRUE(matched_) << "the service did not show up on domain " << test_domain();
+    ASSERT_TRUE(matched_) << "the service did not show up on domain " << domain_->domain();
     ASSERT_TRUE(service_->running());
   }
 
-  static std::unique_ptr<ServiceProcess> service_;
+  static std::unique_ptr<integration::DomainLease> domain_;
+  static std::unique_ptr<ServiceChild> service_;
   static std::unique_ptr<TestClient> client_;
   static bool matched_;
 };
 
-std::unique_ptr<ServiceProcess> ServiceDds::service_;
+std::unique_ptr<integration::DomainLease> ServiceDds::domain_;
+std::unique_ptr<ServiceChild> ServiceDds::service_;
 std::unique_ptr<TestClient> ServiceDds::client_;
 bool ServiceDds::matched_ = false;
 
@@ -426,8 +436,6 @@ TEST_F(ServiceDds, MalformedRequestIsRejectedNamingTheField) {
 }
 
 TEST_F(ServiceDds, UndecodableSampleIsDroppedAndTheServiceGoesOn) {
-  // Wait until the garbage writer is matched too, so that the sample is really delivered.
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
   ASSERT_TRUE(client_->send_garbage("garbage-1"));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   ASSERT_TRUE(service_->running());

@@ -34,24 +34,25 @@ StartCandidateSearch search_start_candidates(const PlanningContext& ctx, const P
   const double last_margin = p.collision_check_margins.back();
   for (double back = 0.0; back <= allowed + 1e-9; back += p.backward_search_resolution) {
     const Pose2 pose = back == 0.0 ? ego : backed_pose(lanes, proj.s, proj.lateral, back);
-    const std::string at = "start candidate " + format_fixed(back, 1) + " m back";
+    const std::string at = "start candidate";
     if (back > 0.0) {
       const auto hit = ctx.objects.clearance(pose, last_margin);
       if (hit.distance < last_margin) {
-        out.skipped.push_back(at + ": within " + format_fixed(last_margin, 2) + " m of object " +
-                              std::to_string(hit.obstacle_id) + ", search ends");
+        out.skipped.push_back({back, at + " within " + format_fixed(last_margin, 2) + " m of object " +
+                                         std::to_string(hit.obstacle_id) + ": backward search ends"});
         break;
       }
     }
     const auto front = ctx.objects.clearance_ahead(pose, p.collision_check_margin_from_front_object);
     if (front.distance < p.collision_check_margin_from_front_object) {
-      out.skipped.push_back(at + ": " + format_fixed(front.distance, 2) + " m from object " +
-                            std::to_string(front.obstacle_id) + " ahead (collision_check_margin_from_front_object " +
-                            format_fixed(p.collision_check_margin_from_front_object, 1) + " m)");
+      out.skipped.push_back({back, at + " skipped: " + format_fixed(front.distance, 2) + " m from object " +
+                                       std::to_string(front.obstacle_id) +
+                                       " ahead (collision_check_margin_from_front_object " +
+                                       format_fixed(p.collision_check_margin_from_front_object, 1) + " m)"});
       continue;
     }
     if (lanes.centerline.length() - (proj.s - back) < p.ignore_distance_from_lane_end) {
-      out.skipped.push_back(at + ": closer than ignore_distance_from_lane_end to the end of the lanes");
+      out.skipped.push_back({back, at + " skipped: closer than ignore_distance_from_lane_end to the lanes' end"});
       continue;
     }
     out.candidates.push_back({pose, back});

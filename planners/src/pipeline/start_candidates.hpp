@@ -15,7 +15,11 @@ struct StartCandidate {
 
 struct StartCandidateSearch {
   std::vector<StartCandidate> candidates;
-  std::vector<std::string> skipped;  // one line per candidate skipped or ending the search
+  struct Skipped {
+    double backward_distance{0.0};
+    std::string reason;
+  };
+  std::vector<Skipped> skipped;  // candidates skipped, and the one that ended the search
 };
 
 // With enable_back: poses every backward_search_resolution behind the vehicle on the line

@@ -95,7 +95,7 @@ std::vector<std::string> no_path_reasons(const std::vector<PlannerAttempt>& atte
   if (attempts.empty()) return reasons;
   const double last_margin = attempts.back().margin_m;
   for (const PlannerAttempt& a : attempts) {
-    if (a.margin_m != last_margin) continue;
+    if (a.planner == PlannerType::kNone || a.margin_m != last_margin) continue;
     reasons.push_back(std::string(to_string(a.planner)) + " at margin " + format_margin(a.margin_m) +
                       " m, backward " + format_margin(a.backward_distance_m) + " m: " + a.outcome);
   }
@@ -183,8 +183,8 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   // Start candidates: the current pose, then poses behind it (enable_back).
   const StartCandidateSearch search = search_start_candidates(context, request.ego_pose);
   const std::vector<StartCandidate>& starts = search.candidates;
-  for (const std::string& line : search.skipped) {
-    result.evaluation_table.push_back({PlannerType::kNone, 0.0, 0.0, line});
+  for (const auto& skipped : search.skipped) {
+    result.evaluation_table.push_back({PlannerType::kNone, 0.0, skipped.backward_distance, skipped.reason});
   }
   // The order of (candidate, planner) pairs inside one margin, per search_policy.
   std::vector<std::pair<std::size_t, std::size_t>> order;
@@ -251,7 +251,9 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     result.path.reasons.push_back(result.stop_reason);
   } else if (starts.empty()) {
     result.stop_reason = "no start pose candidate: boxed in";
-    result.path.reasons = search.skipped;
+    for (const auto& skipped : search.skipped) {
+      result.path.reasons.push_back(skipped.reason + " (" + format_margin(skipped.backward_distance) + " m back)");
+    }
   } else {
     result.stop_reason = "no safe path at any collision margin";
   }
