@@ -225,6 +225,9 @@ TEST_F(PullOutFlow, FiveThousandPointPathArrives) {
   std::size_t points = 0;
   for (const auto& segment : path->partial_paths) points += segment.points.size();
   EXPECT_GE(points, 5000u);
+  RecordProperty("points", static_cast<int>(points));
+  RecordProperty("send_to_path_ms",
+                 static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(elapsed).count()));
   EXPECT_LT(elapsed, kBound) << "took " << std::chrono::duration_cast<std::chrono::milliseconds>(elapsed).count()
                              << " ms";
   const auto status = client->wait_for_status(

@@ -20,6 +20,35 @@ std::vector<Vec2> to_vecs(const std::vector<Point2>& pts) {
   return out;
 }
 
+constexpr std::size_t kPieceVertices = 16;   // bound vertices per lane piece (each side)
+
+// Vertices of `line` strictly between arc lengths s0 and s1, in order.
+void append_between(const Polyline& line, double s0, double s1, Polygon& out) {
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    if (line.s(i) > s0 + 1e-9 && line.s(i) < s1 - 1e-9) out.push_back(line.point(i));
+  }
+}
+
+// The lane polygon cut into pieces at common normalised arc lengths of both bounds.
+std::vector<Polygon> cut_into_pieces(const Polyline& left, const Polyline& right) {
+  const std::size_t n = std::max<std::size_t>(1, std::max(left.size(), right.size()) / kPieceVertices);
+  std::vector<Polygon> pieces;
+  pieces.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t0 = static_cast<double>(k) / static_cast<double>(n);
+    const double t1 = static_cast<double>(k + 1) / static_cast<double>(n);
+    Polygon piece{left.point_at(t0 * left.length())};
+    append_between(left, t0 * left.length(), t1 * left.length(), piece);
+    piece.push_back(left.point_at(t1 * left.length()));
+    Polygon right_part{right.point_at(t0 * right.length())};
+    append_between(right, t0 * right.length(), t1 * right.length(), right_part);
+    right_part.push_back(right.point_at(t1 * right.length()));
+    piece.insert(piece.end(), right_part.rbegin(), right_part.rend());
+    pieces.push_back(std::move(piece));
+  }
+  return pieces;
+}
+
 // Midline of two bounds, matched by normalised arc length.
 Polyline derive_centerline(const Polyline& left, const Polyline& right) {
   const double len = std::max(left.length(), right.length());
@@ -53,6 +82,8 @@ LaneWorld::LaneWorld(const std::vector<Lane>& lanes) {
     g.polygon = g.left.points();
     g.polygon.insert(g.polygon.end(), g.right.points().rbegin(), g.right.points().rend());
     g.box = bounding_box(g.polygon);
+    g.pieces = cut_into_pieces(g.left, g.right);
+    for (const Polygon& piece : g.pieces) g.piece_boxes.push_back(bounding_box(piece));
     g.speed_limit_mps = in.speed_limit_mps;
     lanes_.push_back(std::move(g));
   }
@@ -95,7 +126,11 @@ void LaneWorld::for_cells(const Aabb& box, F&& f) const {
 
 void LaneWorld::build_index() {
   for (std::size_t i = 0; i < lanes_.size(); ++i) {
-    for_cells(lanes_[i].box, [&](std::int64_t key) { lane_cells_[key].push_back(static_cast<std::uint32_t>(i)); });
+    for (std::size_t k = 0; k < lanes_[i].pieces.size(); ++k) {
+      for_cells(lanes_[i].piece_boxes[k], [&](std::int64_t key) {
+        lane_cells_[key].emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k));
+      });
+    }
   }
   // An edge piece belongs to the outline of the union unless the point just outside it lies in
   // another lane (a shared bound, or the joint between consecutive lanes). Pieces are short so
@@ -138,35 +173,34 @@ void LaneWorld::build_index() {
   }
 }
 
-std::vector<std::size_t> LaneWorld::lanes_containing(const Vec2& p) const {
-  std::vector<std::size_t> out;
+template <typename F>
+bool LaneWorld::any_piece_containing(const Vec2& p, F&& accept) const {
   const auto it = lane_cells_.find(cell_key(static_cast<long>(std::floor(p.x() / cell_size_)),
                                             static_cast<long>(std::floor(p.y() / cell_size_))));
-  if (it == lane_cells_.end()) return out;
-  for (std::uint32_t i : it->second) {
-    if (lanes_[i].box.contains(p) && point_in_polygon(lanes_[i].polygon, p)) out.push_back(i);
+  if (it == lane_cells_.end()) return false;
+  for (const auto& [lane, piece] : it->second) {
+    const LaneGeometry& g = lanes_[lane];
+    if (g.piece_boxes[piece].contains(p) && point_in_polygon(g.pieces[piece], p) && accept(lane)) return true;
   }
+  return false;
+}
+
+std::vector<std::size_t> LaneWorld::lanes_containing(const Vec2& p) const {
+  std::vector<std::size_t> out;
+  any_piece_containing(p, [&out](std::size_t lane) {
+    // A point on the cut between two pieces may be reported by both.
+    if (std::find(out.begin(), out.end(), lane) == out.end()) out.push_back(lane);
+    return false;  // keep looking: the point may lie in several lanes
+  });
   return out;
 }
 
 bool LaneWorld::inside_other_lane(const Vec2& p, std::size_t lane) const {
-  const auto it = lane_cells_.find(cell_key(static_cast<long>(std::floor(p.x() / cell_size_)),
-                                            static_cast<long>(std::floor(p.y() / cell_size_))));
-  if (it == lane_cells_.end()) return false;
-  for (std::uint32_t i : it->second) {
-    if (i != lane && lanes_[i].box.contains(p) && point_in_polygon(lanes_[i].polygon, p)) return true;
-  }
-  return false;
+  return any_piece_containing(p, [lane](std::size_t other) { return other != lane; });
 }
 
 bool LaneWorld::contains(const Vec2& p) const {
-  const auto it = lane_cells_.find(cell_key(static_cast<long>(std::floor(p.x() / cell_size_)),
-                                            static_cast<long>(std::floor(p.y() / cell_size_))));
-  if (it == lane_cells_.end()) return false;
-  for (std::uint32_t i : it->second) {
-    if (lanes_[i].box.contains(p) && point_in_polygon(lanes_[i].polygon, p)) return true;
-  }
-  return false;
+  return any_piece_containing(p, [](std::size_t) { return true; });
 }
 
 std::optional<std::size_t> LaneWorld::nearest_lane(const Vec2& p, LaneSubtype subtype) const {

@@ -26,6 +26,10 @@ struct LaneGeometry {
   Polyline centerline;  // given, or the midpoints of the bounds resampled by arc length
   Polygon polygon;      // left bound forward, right bound backward
   Aabb box;
+  // The polygon cut across the lane into pieces of a few dozen vertices (by normalised arc
+  // length on both bounds), so that point-in-lane tests stay cheap on long, dense lanes.
+  std::vector<Polygon> pieces;
+  std::vector<Aabb> piece_boxes;
   double speed_limit_mps{0.0};
   std::vector<std::size_t> successors;
   std::vector<std::size_t> predecessors;
@@ -76,7 +80,10 @@ class LaneWorld {
   // Pieces of lane edges that are not shared with a neighbouring lane: the outline of the union.
   std::vector<std::pair<Vec2, Vec2>> outer_edges_;
   double cell_size_{4.0};
-  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> lane_cells_;
+  // Cell -> (lane index, piece index) of the lane pieces overlapping the cell.
+  std::unordered_map<std::int64_t, std::vector<std::pair<std::uint32_t, std::uint32_t>>> lane_cells_;
+  template <typename F>
+  bool any_piece_containing(const Vec2& p, F&& accept) const;
   std::unordered_map<std::int64_t, std::vector<std::uint32_t>> edge_cells_;
 };
 
