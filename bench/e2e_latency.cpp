@@ -14,17 +14,21 @@
 //                 serialized size) both ways, and a request-sized ping answered by the
 //                 reply-sized sample (the shape of request -> path).
 // request -> path is one round trip, so the e2e figure compares with a ping-pong ROUND TRIP
-// plus the planning time: overhead = e2e p50 - (planning p50 + round trip p50).
+// plus the planning time: overhead = e2e p50 - (planning p50 + round trip p50). The overhead is
+// what the service and the client add: conversions, the dispatcher and worker hand-offs, the
+// PLANNING status written before the search, the client's thread waking the waiter.
 //
 // Prints a markdown table. Every wait is bounded; both child processes are stopped by PID
 // (SIGTERM, SIGKILL after a timeout) also on failure. Not a unit test: results go to
 // bench/RESULTS.md by hand, with the machine's load (uptime) at the time.
+#include <pthread.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <optional>

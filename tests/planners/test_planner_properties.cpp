@@ -128,12 +128,12 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
   for (const Lane& l : sc.request.lanes) lanes.push_back(lane_polygon(l));
   const Footprint footprint = vehicle_footprint(sc.vehicle);
   const double expansion = planner_type == PlannerType::kGeometric ? params.lane_departure_margin
-                                                                     : params.lane_departure_check_expansion_margin;
+                                                                   : params.lane_departure_check_expansion_margin;
   const Footprint lane_footprint = vehicle_footprint(sc.vehicle, expansion);
   // Where the margin applies: up to the end pose, minus 10 m for shift
   // (shift_collision_check_distance_from_end); beyond that only contact is excluded.
-  const double margin_until_end = planner_type == PlannerType::kShift ? params.shift_collision_check_distance_from_end
-                                                                        : 0.0;
+  const double margin_until_end =
+      planner_type == PlannerType::kShift ? params.shift_collision_check_distance_from_end : 0.0;
   bool passed_end = false;
   double forward_distance = 0.0;
   double end_distance = -1.0;
@@ -143,8 +143,12 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
     for (const auto& seg : path.partial_paths) {
       if (direction_of(seg) < 0.0) continue;
       for (std::size_t i = 0; i < seg.points.size(); ++i) {
-        if (i > 0) d += std::hypot(seg.points[i].pose.x - seg.points[i - 1].pose.x, seg.points[i].pose.y - seg.points[i - 1].pose.y);
-        if (end_distance < 0 && std::hypot(seg.points[i].pose.x - path.end_pose.x, seg.points[i].pose.y - path.end_pose.y) < 1e-6) end_distance = d;
+        if (i > 0)
+          d += std::hypot(seg.points[i].pose.x - seg.points[i - 1].pose.x,
+                          seg.points[i].pose.y - seg.points[i - 1].pose.y);
+        if (end_distance < 0 &&
+            std::hypot(seg.points[i].pose.x - path.end_pose.x, seg.points[i].pose.y - path.end_pose.y) < 1e-6)
+          end_distance = d;
       }
     }
     ASSERT_GE(end_distance, 0.0) << "end_pose is a point of the path";
@@ -174,13 +178,15 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
         forward_distance += std::hypot(pose.x - seg.points[i - 1].pose.x, pose.y - seg.points[i - 1].pose.y);
       }
       double clearance = std::numeric_limits<double>::infinity();
-      for (const Polygon& o : obstacles) clearance = std::min(clearance, polygon_distance(footprint_polygon(footprint, pose), o));
+      for (const Polygon& o : obstacles)
+        clearance = std::min(clearance, polygon_distance(footprint_polygon(footprint, pose), o));
       EXPECT_GT(clearance, 0.0) << "contact at segment " << k << " point " << i;
       if (dir > 0.0 && forward_distance <= end_distance + margin_until_end + 1e-9) {
         // 1e-3: FCL's GJK and this oracle agree to well below a millimetre.
         EXPECT_GE(clearance, margin - 1e-3) << "margin at segment " << k << " point " << i;
       }
-      EXPECT_TRUE(footprint_in_lanes(lane_footprint, pose, lanes)) << "lane departure at segment " << k << " point " << i;
+      EXPECT_TRUE(footprint_in_lanes(lane_footprint, pose, lanes))
+          << "lane departure at segment " << k << " point " << i;
       if (dir > 0.0 && std::hypot(pose.x - path.end_pose.x, pose.y - path.end_pose.y) < 1e-6) {
         passed_end = true;
         break;
@@ -252,7 +258,8 @@ TEST(ScenarioSpecifics, ParallelSpotStopsBetweenTheArcsWithConsistentPairs) {
   const auto& arc1 = r.path.partial_paths[0].points;
   EXPECT_DOUBLE_EQ(arc1.back().longitudinal_velocity_mps, 0.0);
   double l1 = 0.0;
-  for (std::size_t i = 1; i < arc1.size(); ++i) l1 += std::hypot(arc1[i].pose.x - arc1[i - 1].pose.x, arc1[i].pose.y - arc1[i - 1].pose.y);
+  for (std::size_t i = 1; i < arc1.size(); ++i)
+    l1 += std::hypot(arc1[i].pose.x - arc1[i - 1].pose.x, arc1[i].pose.y - arc1[i - 1].pose.y);
   const auto pair1 = r.path.pairs_terminal_velocity_and_accel[0];
   // Reaching v at half of the arc with constant acceleration: a = v^2 / L1 (2 % for chords).
   EXPECT_NEAR(pair1.accel_mps2, pair1.velocity_mps * pair1.velocity_mps / l1, 0.02 * pair1.accel_mps2);

@@ -5,9 +5,7 @@
 
 namespace pullout {
 
-double Footprint::bounding_radius() const {
-  return std::hypot(std::max(front, rear), std::max(left, right));
-}
+double Footprint::bounding_radius() const { return std::hypot(std::max(front, rear), std::max(left, right)); }
 
 Footprint vehicle_footprint(const VehicleInfo& vehicle, double expansion) {
   return {vehicle.base_to_front_m() + expansion, vehicle.base_to_rear_m() + expansion,
@@ -15,8 +13,8 @@ Footprint vehicle_footprint(const VehicleInfo& vehicle, double expansion) {
 }
 
 std::array<Vec2, 4> footprint_corners(const Footprint& f, const Pose2& pose) {
-  return {to_global(pose, {f.front, f.left}), to_global(pose, {-f.rear, f.left}),
-          to_global(pose, {-f.rear, -f.right}), to_global(pose, {f.front, -f.right})};
+  return {to_global(pose, {f.front, f.left}), to_global(pose, {-f.rear, f.left}), to_global(pose, {-f.rear, -f.right}),
+          to_global(pose, {f.front, -f.right})};
 }
 
 Polygon footprint_polygon(const Footprint& footprint, const Pose2& pose) {
@@ -33,8 +31,8 @@ Polygon object_polygon(const Object& object) {
   }
   const double hl = object.length_m / 2.0;
   const double hw = object.width_m / 2.0;
-  return {to_global(object.pose, {hl, hw}), to_global(object.pose, {-hl, hw}),
-          to_global(object.pose, {-hl, -hw}), to_global(object.pose, {hl, -hw})};
+  return {to_global(object.pose, {hl, hw}), to_global(object.pose, {-hl, hw}), to_global(object.pose, {-hl, -hw}),
+          to_global(object.pose, {hl, -hw})};
 }
 
 }  // namespace pullout

@@ -1,11 +1,11 @@
 #include "pullout/collision/object_checker.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/convex.h>
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
+#include <algorithm>
+#include <cmath>
 
 namespace pullout {
 
@@ -21,9 +21,8 @@ double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
 
 // Andrew's monotone chain; counter-clockwise, no collinear points.
 Polygon convex_hull(Polygon pts) {
-  std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
+  std::sort(pts.begin(), pts.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
   if (pts.size() < 3) return pts;
   Polygon hull(2 * pts.size());
@@ -151,8 +150,7 @@ ObjectChecker::Clearance ObjectChecker::clearance_if(const Pose2& pose, double h
   return best;
 }
 
-std::optional<ObjectChecker::Hit> ObjectChecker::first_hit(const std::vector<Pose2>& poses,
-                                                          double margin) const {
+std::optional<ObjectChecker::Hit> ObjectChecker::first_hit(const std::vector<Pose2>& poses, double margin) const {
   if (impl_->obstacles.empty()) return std::nullopt;
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const Clearance c = clearance(poses[i], margin);

@@ -8,10 +8,10 @@ namespace pullout {
 
 namespace {
 
-constexpr double kConnectTolerance = 0.1;    // [m] bound end points closer than this connect lanes
-constexpr double kEdgePieceLength = 0.5;     // [m] lane edges are split into pieces this long
-constexpr double kSharedEdgeProbe = 0.05;    // [m] probe distance outside an edge piece
-constexpr double kCenterlineStep = 0.5;      // [m] sampling of derived centerlines
+constexpr double kConnectTolerance = 0.1;  // [m] bound end points closer than this connect lanes
+constexpr double kEdgePieceLength = 0.5;   // [m] lane edges are split into pieces this long
+constexpr double kSharedEdgeProbe = 0.05;  // [m] probe distance outside an edge piece
+constexpr double kCenterlineStep = 0.5;    // [m] sampling of derived centerlines
 
 std::vector<Vec2> to_vecs(const std::vector<Point2>& pts) {
   std::vector<Vec2> out;
@@ -20,7 +20,7 @@ std::vector<Vec2> to_vecs(const std::vector<Point2>& pts) {
   return out;
 }
 
-constexpr std::size_t kPieceVertices = 16;   // bound vertices per lane piece (each side)
+constexpr std::size_t kPieceVertices = 16;  // bound vertices per lane piece (each side)
 
 // Vertices of `line` strictly between arc lengths s0 and s1, in order.
 void append_between(const Polyline& line, double s0, double s1, Polygon& out) {
@@ -175,8 +175,8 @@ void LaneWorld::build_index() {
 
 template <typename F>
 bool LaneWorld::any_piece_containing(const Vec2& p, F&& accept) const {
-  const auto it = lane_cells_.find(cell_key(static_cast<long>(std::floor(p.x() / cell_size_)),
-                                            static_cast<long>(std::floor(p.y() / cell_size_))));
+  const auto it = lane_cells_.find(
+      cell_key(static_cast<long>(std::floor(p.x() / cell_size_)), static_cast<long>(std::floor(p.y() / cell_size_))));
   if (it == lane_cells_.end()) return false;
   for (const auto& [lane, piece] : it->second) {
     const LaneGeometry& g = lanes_[lane];

@@ -66,7 +66,8 @@ PathWithLaneId reverse_segment(const PlanningContext& ctx, const Pose2& ego, con
   const auto proj = lanes.centerline.project(to_vec(ego));
   PathWithLaneId seg;
   const double step = p.center_line_path_interval;
-  const auto n = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(candidate.backward_distance / step - 1e-9)));
+  const auto n =
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(candidate.backward_distance / step - 1e-9)));
   for (std::size_t i = 0; i <= n; ++i) {
     const double back = candidate.backward_distance * static_cast<double>(i) / static_cast<double>(n);
     PathPoint pt;

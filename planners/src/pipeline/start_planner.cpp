@@ -96,8 +96,8 @@ std::vector<std::string> no_path_reasons(const std::vector<PlannerAttempt>& atte
   const double last_margin = attempts.back().margin_m;
   for (const PlannerAttempt& a : attempts) {
     if (a.planner == PlannerType::kNone || a.margin_m != last_margin) continue;
-    reasons.push_back(std::string(to_string(a.planner)) + " at margin " + format_margin(a.margin_m) +
-                      " m, backward " + format_margin(a.backward_distance_m) + " m: " + a.outcome);
+    reasons.push_back(std::string(to_string(a.planner)) + " at margin " + format_margin(a.margin_m) + " m, backward " +
+                      format_margin(a.backward_distance_m) + " m: " + a.outcome);
   }
   return reasons;
 }

@@ -35,8 +35,8 @@ class Checker {
   }
   bool points(const std::string& field, const std::vector<Point2>& pts) {
     if (pts.size() > limits_.max_points_per_line) {
-      add(field, std::to_string(pts.size()) + " points exceed the limit of " +
-                     std::to_string(limits_.max_points_per_line));
+      add(field,
+          std::to_string(pts.size()) + " points exceed the limit of " + std::to_string(limits_.max_points_per_line));
       return false;
     }
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -123,7 +123,8 @@ void validate_object(Checker& c, const std::string& f, const Object& o, const Re
     const PredictedPath& pp = o.predicted_paths[k];
     const std::string pf = f + ".predicted_paths[" + std::to_string(k) + "]";
     if (!c.count(pf, pp.poses.size(), limits.max_predicted_path_points, "poses")) continue;
-    if (c.finite(pf + ".time_step_s", pp.time_step_s) && pp.time_step_s <= 0.0) c.add(pf + ".time_step_s", "must be positive");
+    if (c.finite(pf + ".time_step_s", pp.time_step_s) && pp.time_step_s <= 0.0)
+      c.add(pf + ".time_step_s", "must be positive");
     for (std::size_t i = 0; i < pp.poses.size(); ++i) {
       if (!c.pose(pf + ".poses[" + std::to_string(i) + "]", pp.poses[i])) break;
     }
@@ -181,8 +182,8 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
     }
     c.pose("occupancy_grid.origin", g.origin);
     if (c.count("occupancy_grid", cells, limits.max_grid_cells, "cells") && g.data.size() != cells) {
-      c.add("occupancy_grid.data", "has " + std::to_string(g.data.size()) + " cells, width x height is " +
-                                       std::to_string(cells));
+      c.add("occupancy_grid.data",
+            "has " + std::to_string(g.data.size()) + " cells, width x height is " + std::to_string(cells));
     }
   }
 

@@ -44,7 +44,8 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
     // A short first arc cannot reach v comfortably before stopping: cruise at what
     // maximum_longitudinal_acc reaches over half of it.
     const double v1 = divide ? std::min(v, std::sqrt(p.maximum_longitudinal_acc * first_turn_length)) : v;
-    auto segment = [divide, first_turn, v, v1](const std::vector<Pose2>& pts, const std::vector<std::size_t>& junctions) {
+    auto segment = [divide, first_turn, v, v1](const std::vector<Pose2>& pts,
+                                               const std::vector<std::size_t>& junctions) {
       TurnSegmentation seg;
       const auto length_between = [&pts](std::size_t a, std::size_t b) {
         double len = 0.0;

@@ -11,8 +11,8 @@ namespace pullout {
 
 namespace {
 
-constexpr double kMinShiftLength = 0.01;          // [m] below this the start is on the centerline
-constexpr double kMaxStartYawDeviation = 0.35;    // [rad] (20 deg) between start heading and lane
+constexpr double kMinShiftLength = 0.01;        // [m] below this the start is on the centerline
+constexpr double kMaxStartYawDeviation = 0.35;  // [rad] (20 deg) between start heading and lane
 
 // Arc length where the shift may end: the first centerline position at or after s0 whose
 // curvature is below the threshold, or the least curved one if none is (so that the shift does
@@ -274,8 +274,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
     }
     // Collision section: from the start to end_pose + shift_collision_check_distance_from_end.
     const double s_check_end = shape->end() + params.shift_collision_check_distance_from_end;
-    auto c = std::make_shared<Candidate>(
-        sample_poses(ctx, *shape, s_start, end, std::max(shape->end(), s_check_end)));
+    auto c = std::make_shared<Candidate>(sample_poses(ctx, *shape, s_start, end, std::max(shape->end(), s_check_end)));
     std::size_t section_last = 0;
     while (section_last + 1 < c->s.size() && c->s[section_last + 1] <= s_check_end) ++section_last;
     check_candidate(ctx, c->poses,

@@ -10,8 +10,8 @@ namespace {
 // [m] pose spacing of the lane and collision checks on turns: at the tightest radius (about 5 m)
 // a footprint corner moves along an arc whose sagitta between samples stays below 1 cm.
 constexpr double kCheckInterval = 0.5;
-constexpr double kWindowBehind = 5.0;    // [m] centerline window around the start
-constexpr double kWindowAhead = 35.0;    // two turns and a 9 m tangent end within about 25 m
+constexpr double kWindowBehind = 5.0;  // [m] centerline window around the start
+constexpr double kWindowAhead = 35.0;  // two turns and a 9 m tangent end within about 25 m
 constexpr double kWindowStep = 1.0;
 
 std::vector<double> cumulative_distance(const std::vector<Pose2>& poses) {

@@ -10,9 +10,9 @@ namespace pullout {
 
 struct TurnCandidateOptions {
   bool check_lanes{true};
-  double departure_expansion{0.0};       // [m] footprint expansion for the lane check
+  double departure_expansion{0.0};          // [m] footprint expansion for the lane check
   double collision_distance_from_end{0.0};  // [m] collision section end relative to the end pose
-  double output_interval{1.0};           // [m] point spacing on the turns
+  double output_interval{1.0};              // [m] point spacing on the turns
 };
 
 // Velocity of the turn points: given the distance from the start along the turns [m].
@@ -30,8 +30,9 @@ Polyline turn_window(const PlanningContext& context, const Pose2& start);
 
 // Checks `turns` and returns the candidate; build() composes the partial paths: the turn points,
 // split as `segmentation` says, then the road centerline to the goal or forward_path_length.
-PathCandidate make_turn_candidate(const PlanningContext& context, const TwoTurnPath& turns,
-                                  const TurnCandidateOptions& options, TurnVelocity velocity,
-                                  std::function<TurnSegmentation(const std::vector<Pose2>&, const std::vector<std::size_t>&)> segment);
+PathCandidate make_turn_candidate(
+    const PlanningContext& context, const TwoTurnPath& turns, const TurnCandidateOptions& options,
+    TurnVelocity velocity,
+    std::function<TurnSegmentation(const std::vector<Pose2>&, const std::vector<std::size_t>&)> segment);
 
 }  // namespace pullout

@@ -7,10 +7,10 @@ namespace pullout {
 
 namespace {
 
-constexpr double kLateralTolerance = 1e-4;    // [m] root accuracy
-constexpr double kJoinTolerance = 0.05;       // [m] accepted distance of the end to the centerline
-constexpr double kHeadingTolerance = 0.035;   // [rad] (2 deg) accepted heading mismatch at the end
-constexpr double kParallelStart = 0.05;       // [rad] start counts as parallel to the road below this
+constexpr double kLateralTolerance = 1e-4;   // [m] root accuracy
+constexpr double kJoinTolerance = 0.05;      // [m] accepted distance of the end to the centerline
+constexpr double kHeadingTolerance = 0.035;  // [rad] (2 deg) accepted heading mismatch at the end
+constexpr double kParallelStart = 0.05;      // [rad] start counts as parallel to the road below this
 constexpr int kMaxHeadingIterations = 4;
 constexpr int kMaxRootIterations = 40;
 
@@ -32,7 +32,8 @@ std::vector<CurvaturePiece> two_turns(double d1, double d2, const TwoTurnSpec& s
 Evaluation evaluate(const Pose2& start, double d1, double psi_target, const Polyline& center, const TwoTurnSpec& spec) {
   const double d2 = normalize_angle(psi_target - start.yaw - d1);
   Pose2 p = start;
-  for (const CurvaturePiece& piece : two_turns(d1, d2, spec, nullptr)) p = CurvaturePath::advance(p, piece, piece.length);
+  for (const CurvaturePiece& piece : two_turns(d1, d2, spec, nullptr))
+    p = CurvaturePath::advance(p, piece, piece.length);
   const auto proj = center.project(to_vec(p));
   return {proj.lateral, proj.s, p};
 }

@@ -31,7 +31,7 @@ class ObjectChecker {
 
   struct Clearance {
     double distance{std::numeric_limits<double>::infinity()};  // [m], 0 when overlapping
-    std::int64_t obstacle_id{0};                                 // the nearest one
+    std::int64_t obstacle_id{0};                               // the nearest one
   };
   // Smallest distance from the footprint at X_MV = `pose` to any obstacle, considering only
   // obstacles closer than `horizon` (others report +inf).

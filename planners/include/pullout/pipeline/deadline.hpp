@@ -13,8 +13,7 @@ class Deadline {
 
   // No limit.
   Deadline() = default;
-  explicit Deadline(Clock::time_point at, const std::atomic<bool>* cancel = nullptr)
-      : at_(at), cancel_(cancel) {}
+  explicit Deadline(Clock::time_point at, const std::atomic<bool>* cancel = nullptr) : at_(at), cancel_(cancel) {}
 
   static Deadline after(std::chrono::nanoseconds budget, const std::atomic<bool>* cancel = nullptr) {
     return Deadline(Clock::now() + budget, cancel);

@@ -33,7 +33,7 @@ struct StartPlannerParameters {
   double th_stopped_time{1.0};       // [s] stopped for this long before a segment counts as done
 
   // --- search ---
-  std::vector<double> collision_check_margins{2.0, 1.0, 0.5, 0.1};  // [m] tried in order
+  std::vector<double> collision_check_margins{2.0, 1.0, 0.5, 0.1};                         // [m] tried in order
   std::vector<PlannerType> search_priority{PlannerType::kShift, PlannerType::kGeometric};  // in order
   SearchPolicy search_policy{SearchPolicy::kPlannerPriority};
 
@@ -63,26 +63,26 @@ struct StartPlannerParameters {
 
   // --- backward start-pose search ---
   bool enable_back{true};
-  double max_back_distance{20.0};                       // [m]
-  double backward_search_resolution{2.0};               // [m] spacing of start candidates
+  double max_back_distance{20.0};                        // [m]
+  double backward_search_resolution{2.0};                // [m] spacing of start candidates
   double collision_check_margin_from_front_object{5.0};  // [m] candidates this close to an object ahead are skipped
-  double ignore_distance_from_lane_end{0.0};            // [m] candidates this close to the lane end are skipped
-  double backward_velocity{-1.0};                       // [m/s] < 0, speed of the reverse segment
+  double ignore_distance_from_lane_end{0.0};             // [m] candidates this close to the lane end are skipped
+  double backward_velocity{-1.0};                        // [m/s] < 0, speed of the reverse segment
 
   // --- geometric pull-out (two arcs joined by a common tangent) ---
-  double geometric_pull_out_velocity{1.0};                      // [m/s]
-  double arc_path_interval{1.0};                                // [m] point spacing on the arcs
-  double lane_departure_margin{0.2};                            // [m] footprint clearance to the lane edge
+  double geometric_pull_out_velocity{1.0};                       // [m/s]
+  double arc_path_interval{1.0};                                 // [m] point spacing on the arcs
+  double lane_departure_margin{0.2};                             // [m] footprint clearance to the lane edge
   double geometric_pull_out_max_steer_angle_margin_scale{0.72};  // x vehicle max steer
-  bool divide_pull_out_path{true};                              // stop between the arcs to re-steer
-  double geometric_collision_check_distance_from_end{0.0};      // [m]
+  bool divide_pull_out_path{true};                               // stop between the arcs to re-steer
+  double geometric_collision_check_distance_from_end{0.0};       // [m]
 
   // --- clothoid pull-out (clothoid-arc-clothoid turns) ---
-  double clothoid_initial_velocity{1.0};                        // [m/s]
-  double clothoid_acceleration{1.0};                            // [m/s^2]
+  double clothoid_initial_velocity{1.0};                               // [m/s]
+  double clothoid_acceleration{1.0};                                   // [m/s^2]
   std::vector<double> clothoid_max_steer_angles_deg{5.0, 10.0, 20.0};  // tried in order
-  double clothoid_max_steer_angle_rate_deg_per_sec{10.0};       // [deg/s]
-  double clothoid_collision_check_distance_from_end{0.0};       // [m]
+  double clothoid_max_steer_angle_rate_deg_per_sec{10.0};              // [deg/s]
+  double clothoid_collision_check_distance_from_end{0.0};              // [m]
   bool check_clothoid_path_lane_departure{true};
 };
 

@@ -25,9 +25,9 @@ namespace pullout {
 // Everything a planner reads; built once per request by the pipeline and shared by all attempts.
 struct PlanningContext {
   const LaneWorld& world;
-  const LaneChain& road;          // the road lanes the vehicle pulls out onto, in driving order
-  const LaneChain& pull_out;      // the lanes the vehicle stands in (shoulder chain, or `road`)
-  const ObjectChecker& objects;   // static obstacles
+  const LaneChain& road;         // the road lanes the vehicle pulls out onto, in driving order
+  const LaneChain& pull_out;     // the lanes the vehicle stands in (shoulder chain, or `road`)
+  const ObjectChecker& objects;  // static obstacles
   const VehicleInfo& vehicle;
   const StartPlannerParameters& parameters;
   Pose2 goal;
@@ -106,7 +106,7 @@ struct RoadEnd {
   bool is_goal{false};
 };
 RoadEnd find_path_end(const PlanningContext& context, double s_from);
-double speed_limit_at(const PlanningContext& context, double s);   // of the road lane at s
+double speed_limit_at(const PlanningContext& context, double s);  // of the road lane at s
 std::int64_t road_lane_id_at(const PlanningContext& context, double s);
 // The road centerline between s0 and s1 (clamped), resampled every `interval`.
 Polyline centerline_window(const PlanningContext& context, double s0, double s1, double interval);

@@ -58,12 +58,12 @@ struct LateralJerkProfile {
 double calc_shift_time_from_jerk(double shift_length, double lateral_jerk, double lateral_acc);
 
 struct ShiftKinematics {
-  double lateral_acc{0.0};         // sampled a_lat [m/s^2]
+  double lateral_acc{0.0};  // sampled a_lat [m/s^2]
   LateralJerkProfile profile;
-  double shift_time{0.0};          // T [s]
-  double longitudinal_acc{0.0};    // a_lon [m/s^2]
-  double distance{0.0};            // d [m] along the path
-  double terminal_velocity{0.0};   // v_term [m/s]
+  double shift_time{0.0};         // T [s]
+  double longitudinal_acc{0.0};   // a_lon [m/s^2]
+  double distance{0.0};           // d [m] along the path
+  double terminal_velocity{0.0};  // v_term [m/s]
 };
 
 ShiftKinematics compute_shift_kinematics(double shift_length, double lateral_acc, double road_velocity,
@@ -75,8 +75,7 @@ std::vector<double> lateral_acc_samples(const StartPlannerParameters& parameters
 class ShiftPullOut final : public PullOutPlanner {
  public:
   PlannerType type() const override { return PlannerType::kShift; }
-  PlannerCandidates plan(const PlanningContext& context, const Pose2& start,
-                         const Deadline& deadline) const override;
+  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const Deadline& deadline) const override;
 };
 
 }  // namespace pullout

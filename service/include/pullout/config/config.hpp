@@ -21,16 +21,16 @@ class Node;
 namespace pullout {
 
 struct DdsConfig {
-  int domain_id{0};                // 0..232
-  std::string profiles_file;       // Fast DDS XML profiles; relative paths are relative to the config file
+  int domain_id{0};           // 0..232
+  std::string profiles_file;  // Fast DDS XML profiles; relative paths are relative to the config file
   std::string participant_profile{"pullout_participant"};
 };
 
 struct ServiceConfig {
-  int worker_threads{2};            // planning threads, >= 1
+  int worker_threads{2};              // planning threads, >= 1
   double default_deadline_ms{200.0};  // planning budget when a request gives none
   RequestLimits limits;
-  std::string log_level{"info"};    // trace, debug, info, warn, error, critical, off
+  std::string log_level{"info"};  // trace, debug, info, warn, error, critical, off
 };
 
 struct Config {
@@ -57,8 +57,8 @@ Config load_config(const std::string& path);
 // Applies a YAML mapping of start_planner parameters (Autoware names) onto `params`, appending one
 // "<prefix>.<key>: <problem>" line per problem. Used by load_config and by scenario files'
 // `planner:` section.
-void apply_start_planner_parameters(const YAML::Node& node, const std::string& prefix,
-                                    StartPlannerParameters& params, std::vector<std::string>& problems);
+void apply_start_planner_parameters(const YAML::Node& node, const std::string& prefix, StartPlannerParameters& params,
+                                    std::vector<std::string>& problems);
 void apply_vehicle_info(const YAML::Node& node, const std::string& prefix, VehicleInfo& vehicle,
                         std::vector<std::string>& problems);
 

@@ -33,10 +33,10 @@ struct ScenarioExpectation {
 };
 
 struct Scenario {
-  std::string path;         // the file it was loaded from
+  std::string path;  // the file it was loaded from
   std::string description;
-  PullOutRequest request;   // vehicle_id, ego pose, goal, lanes, objects, deadline
-  VehicleInfo vehicle;      // base config's vehicle with the scenario's overrides
+  PullOutRequest request;             // vehicle_id, ego pose, goal, lanes, objects, deadline
+  VehicleInfo vehicle;                // base config's vehicle with the scenario's overrides
   StartPlannerParameters parameters;  // base config's parameters with `planner:` applied
   ScenarioExpectation expect;
 };
