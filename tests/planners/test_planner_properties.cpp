@@ -16,8 +16,9 @@
 namespace pullout {
 namespace {
 
-const char* const kScenarios[] = {"straight_shoulder", "curved_road",       "parked_car_ahead", "boxed_in",
-                                  "parallel_spot",     "perpendicular_bay", "car_close_ahead"};
+const char* const kScenarios[] = {"straight_shoulder", "curved_road",       "parked_car_ahead",      "boxed_in",
+                                  "parallel_spot",     "perpendicular_bay", "parallel_spot_reverse", "car_close_ahead",
+                                  "full_search"};
 const PlannerType kPlanners[] = {PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid};
 
 Scenario load(const std::string& name) {
