@@ -1,7 +1,7 @@
 // Paths made of pieces whose curvature varies linearly with arc length: straight lines (k = 0),
 // circular arcs (k constant) and clothoids (k from k0 to k1). Integrated exactly for lines and
-// arcs and with composite Simpson quadrature for clothoids (error far below 1e-6 m for the piece
-// lengths used here).
+// arcs and with composite Simpson quadrature for clothoids (16 intervals: error below 1e-6 m for
+// a 3 m clothoid turning by 0.45 rad, tests/planners/test_two_turn_path.cpp).
 #pragma once
 
 #include <vector>

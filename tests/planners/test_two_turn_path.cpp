@@ -1,0 +1,145 @@
+#include "pullout/planners/two_turn_path.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pullout/config/scenario.hpp"
+#include "pullout/geometry/curvature_path.hpp"
+#include "pullout/model/types.hpp"
+#include "pullout/pipeline/start_planner.hpp"
+#include "test_world.hpp"
+
+namespace pullout {
+namespace {
+
+Polyline straight_centerline() { return Polyline({{-10.0, 0.0}, {100.0, 0.0}}).resampled(1.0); }
+
+// Menger curvature of consecutive samples.
+double max_sampled_curvature(const std::vector<Pose2>& poses) {
+  double k = 0.0;
+  for (std::size_t i = 1; i + 1 < poses.size(); ++i) {
+    const Vec2 a = to_vec(poses[i - 1]);
+    const Vec2 b = to_vec(poses[i]);
+    const Vec2 c = to_vec(poses[i + 1]);
+    const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    const double denom = (b - a).norm() * (c - b).norm() * (c - a).norm();
+    if (denom > 1e-12) k = std::max(k, std::abs(2.0 * cross / denom));
+  }
+  return k;
+}
+
+TEST(CurvaturePath, ArcEndsWhereGeometrySays) {
+  // A quarter circle of radius 5 to the left from the origin ends at (5, 5) facing +y.
+  const CurvaturePath arc({0.0, 0.0, 0.0}, {{5.0 * M_PI / 2.0, 0.2, 0.2}});
+  EXPECT_NEAR(arc.end().x, 5.0, 1e-12);
+  EXPECT_NEAR(arc.end().y, 5.0, 1e-12);
+  EXPECT_NEAR(arc.end().yaw, M_PI / 2.0, 1e-12);
+}
+
+TEST(CurvaturePath, ClothoidIntegrationMatchesAFineEulerReference) {
+  const CurvaturePiece piece{3.0, 0.0, 0.3};
+  const Pose2 end = CurvaturePath::advance({1.0, 2.0, 0.4}, piece, piece.length);
+  // Reference: 300,000 midpoint steps.
+  double x = 1.0, y = 2.0;
+  const int n = 300000;
+  const double h = piece.length / n;
+  for (int i = 0; i < n; ++i) {
+    const double s = (i + 0.5) * h;
+    const double th = 0.4 + 0.5 * (0.3 / 3.0) * s * s;
+    x += h * std::cos(th);
+    y += h * std::sin(th);
+  }
+  // Simpson with 16 intervals over 0.45 rad of heading change: within a micrometre.
+  EXPECT_NEAR(end.x, x, 1e-6);
+  EXPECT_NEAR(end.y, y, 1e-6);
+  EXPECT_NEAR(end.yaw, 0.4 + 0.45, 1e-12);
+}
+
+TEST(TwoTurnPath, ArcSCurveMatchesTheWorkedExample) {
+  // Reference facts 2.2: d = 3.5 m, R = 5.06 m -> each arc turns acos(1 - d / 2R) (about 49 deg),
+  // 4.34 m of arc each, the end 7.65 m ahead.
+  const double R = 5.06;
+  const auto t = solve_two_turn({0.0, 3.5, 0.0}, straight_centerline(), {1.0 / R, 0.0, 0.0});
+  ASSERT_TRUE(t.has_value());
+  const double theta = std::acos(1.0 - 3.5 / (2.0 * R));
+  ASSERT_EQ(t->path.pieces().size(), 2u);
+  EXPECT_NEAR(t->path.pieces()[0].length, R * theta, 1e-3);
+  EXPECT_NEAR(t->path.pieces()[0].length, 4.34, 0.01);
+  EXPECT_NEAR(t->path.end().x, 2.0 * R * std::sin(theta), 1e-3);
+  EXPECT_NEAR(t->path.end().y, 0.0, 1e-3);
+  EXPECT_NEAR(t->path.end().yaw, 0.0, 1e-9);
+}
+
+TEST(TwoTurnPath, ClothoidTurnsStayWithinTheirPeakCurvature) {
+  const VehicleInfo v;
+  for (double steer_deg : {5.0, 10.0, 20.0, 30.0}) {
+    const double steer = steer_deg * M_PI / 180.0;
+    const double kappa = std::tan(steer) / v.wheel_base_m;
+    const double clothoid_length = 1.0 * steer / (10.0 * M_PI / 180.0);
+    for (double offset : {0.3, 1.0, 3.25, 6.0}) {
+      const auto t = solve_two_turn({0.0, offset, 0.0}, straight_centerline(), {kappa, kappa / clothoid_length, 0.0});
+      ASSERT_TRUE(t.has_value()) << steer_deg << " deg, offset " << offset;
+      const auto& pieces = t->path.pieces();
+      // Curvature is continuous: starts and ends at 0, each piece starts where the last ended.
+      EXPECT_DOUBLE_EQ(pieces.front().k0, 0.0);
+      EXPECT_DOUBLE_EQ(pieces.back().k1, 0.0);
+      for (std::size_t i = 1; i < pieces.size(); ++i) EXPECT_NEAR(pieces[i].k0, pieces[i - 1].k1, 1e-12);
+      EXPECT_LE(t->path.max_abs_curvature(), kappa + 1e-12);
+      // Sampled every 5 cm the geometry agrees (1 % for the discrete estimate).
+      EXPECT_LE(max_sampled_curvature(t->path.sample(0.05)), kappa * 1.01) << steer_deg << " deg, offset " << offset;
+      EXPECT_LE(kappa, 1.0 / v.min_turning_radius_m());
+      EXPECT_NEAR(t->path.end().y, 0.0, 1e-3);
+    }
+  }
+}
+
+TEST(TwoTurnPath, PerpendicularStartTurnsOntoTheLane) {
+  // Facing -y, 6 m left of the centerline: turns left by 90 degrees in total.
+  const auto t = solve_two_turn({0.0, 6.0, -M_PI / 2.0}, straight_centerline(), {0.2, 0.0, 1.0});
+  ASSERT_TRUE(t.has_value());
+  EXPECT_NEAR(t->path.end().y, 0.0, 1e-3);
+  EXPECT_NEAR(t->path.end().yaw, 0.0, 1e-3);
+  EXPECT_GT(t->path.end().x, 0.0);
+}
+
+TEST(TwoTurnPath, NoSolutionWhenTheTurnsCannotReachTheCenterline) {
+  // 20 m to the side with arcs of radius 5 and no tangent: 2R(1 - cos d) <= 10 m < 20 m.
+  EXPECT_FALSE(solve_two_turn({0.0, 20.0, 0.0}, straight_centerline(), {0.2, 0.0, 0.0}).has_value());
+}
+
+TEST(SearchPolicy, OrdersTheAttemptsInsideAMargin) {
+  // full_search: every (candidate, planner) pair fails, so each is tried at every margin.
+  const Scenario sc = load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/full_search.yaml");
+  const auto first_margin_rows = [&](SearchPolicy policy) {
+    StartPlannerParameters p = sc.parameters;
+    p.search_policy = policy;
+    PullOutRequest req = sc.request;
+    req.overrides = {};
+    std::vector<std::pair<PlannerType, double>> out;
+    for (const auto& a : StartPlanner(sc.vehicle, p).plan(req, Deadline()).evaluation_table) {
+      if (a.planner != PlannerType::kNone && a.margin_m == p.collision_check_margins.front()) {
+        out.emplace_back(a.planner, a.backward_distance_m);
+      }
+    }
+    return out;
+  };
+  const auto planner_first = first_margin_rows(SearchPolicy::kPlannerPriority);
+  const auto distance_first = first_margin_rows(SearchPolicy::kDistancePriority);
+  const std::size_t planners = sc.parameters.search_priority.size();
+  ASSERT_EQ(planners, 3u);
+  ASSERT_EQ(planner_first.size(), 33u);  // 11 candidates x 3 planners
+  ASSERT_EQ(distance_first.size(), 33u);
+  const std::size_t candidates = planner_first.size() / planners;
+  for (std::size_t i = 0; i < planner_first.size(); ++i) {
+    // planner_priority: every candidate with the first planner, then with the second, ...
+    EXPECT_EQ(planner_first[i].first, sc.parameters.search_priority[i / candidates]) << i;
+    EXPECT_DOUBLE_EQ(planner_first[i].second, 2.0 * static_cast<double>(i % candidates)) << i;
+    // distance_priority: every planner at the nearest candidate, then at the next, ...
+    EXPECT_EQ(distance_first[i].first, sc.parameters.search_priority[i % planners]) << i;
+    EXPECT_DOUBLE_EQ(distance_first[i].second, 2.0 * static_cast<double>(i / planners)) << i;
+  }
+}
+
+}  // namespace
+}  // namespace pullout
