@@ -160,7 +160,7 @@ class ScenarioExpectations : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(ScenarioExpectations, MatchTheFile) {
   const Scenario sc = load(GetParam());
-  const StartPlanner planner(sc.vehicle, sc.parameters);
+  const StartPlanner planner(sc.vehicle, sc.parameters, {}, sc.map);
   const PlanningResult r = planner.plan(sc.request, Deadline());
   ASSERT_TRUE(sc.expect.found.has_value()) << "every bundled scenario states whether a path exists";
   EXPECT_EQ(r.path.found, *sc.expect.found) << r.stop_reason;
@@ -172,7 +172,11 @@ TEST_P(ScenarioExpectations, MatchTheFile) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Bundled, ScenarioExpectations, ::testing::ValuesIn(kScenarios));
+// The map scenarios too (their path properties are checked in test_map_planning.cpp).
+const char* const kExpectationScenarios[] = {
+    "straight_shoulder", "curved_road",           "parked_car_ahead", "boxed_in",    "parallel_spot",
+    "perpendicular_bay", "parallel_spot_reverse", "car_close_ahead",  "full_search", "map_shoulder"};
+INSTANTIATE_TEST_SUITE_P(Bundled, ScenarioExpectations, ::testing::ValuesIn(kExpectationScenarios));
 
 TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {
   const Scenario sc = load("car_close_ahead");
