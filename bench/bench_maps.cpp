@@ -19,7 +19,8 @@
 
 namespace {
 
-const std::string kIntersection = std::string(PULLOUT_SOURCE_DIR) + "/../shared/maps/autoware_intersection/lanelet2_map.osm";
+const std::string kIntersection =
+    std::string(PULLOUT_SOURCE_DIR) + "/../shared/maps/autoware_intersection/lanelet2_map.osm";
 
 bool have_intersection(benchmark::State& state) {
   if (std::filesystem::exists(kIntersection)) return true;
@@ -76,9 +77,8 @@ void BM_LaneletsContaining(benchmark::State& state) {
 // 10 m (a wider neighbourhood).
 void BM_LaneletsNear(benchmark::State& state) {
   const double radius = static_cast<double>(state.range(0)) / 100.0;
-  query_bench(state, [radius](const pullout::LaneletMap& m, const pullout::Point2& p) {
-    return m.lanelets_near(p, radius);
-  });
+  query_bench(state,
+              [radius](const pullout::LaneletMap& m, const pullout::Point2& p) { return m.lanelets_near(p, radius); });
 }
 
 // A whole route request on the own map (lane selection, world, search): compare with

@@ -129,6 +129,7 @@ TEST(LaneletMap, SpatialQueriesMatchBruteForce) {
   EXPECT_EQ(ids_of(*map, map->lanelets_near({20.0, 2.0}, 0.5)), (std::vector<std::int64_t>{101, 201}));
   EXPECT_TRUE(map->lanelets_near({20.0, 2.0}, -1.0).empty());
   EXPECT_TRUE(map->lanelets_near({NAN, 2.0}, 1.0).empty());
+  EXPECT_EQ(map->lanelets_near({20.0, 2.0}, 1e9).size(), map->lanelets().size());  // no cell walk of 1e17 cells
   // Brute force over every lanelet, on a grid covering the map and beyond.
   for (double x = -30.0; x <= 230.0; x += 3.7) {
     for (double y = -12.0; y <= 12.0; y += 0.9) {

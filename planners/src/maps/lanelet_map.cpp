@@ -223,13 +223,21 @@ std::vector<std::size_t> LaneletMap::lanelets_near(const Point2& p, double radiu
   std::vector<std::size_t> candidates;
   if (!(radius >= 0.0) || !std::isfinite(radius) || !std::isfinite(p.x) || !std::isfinite(p.y)) return candidates;
   const Box2 query{p.x - radius, p.y - radius, p.x + radius, p.y + radius};
-  for_cells(query, [&](std::int64_t key) {
-    const auto it = cells_.find(key);
-    if (it == cells_.end()) return;
-    for (std::uint32_t i : it->second) {
+  const double cells_across = std::ceil(2.0 * radius / cell_size_) + 1.0;
+  if (cells_across * cells_across > static_cast<double>(cells_.size())) {
+    // A query wider than the map: looking at every lanelet is cheaper than at every cell.
+    for (std::size_t i = 0; i < lanelets_.size(); ++i) {
       if (box_distance(lanelets_[i].box, p) <= radius) candidates.push_back(i);
     }
-  });
+  } else {
+    for_cells(query, [&](std::int64_t key) {
+      const auto it = cells_.find(key);
+      if (it == cells_.end()) return;
+      for (std::uint32_t i : it->second) {
+        if (box_distance(lanelets_[i].box, p) <= radius) candidates.push_back(i);
+      }
+    });
+  }
   // A lanelet spanning several cells is listed once per cell.
   std::sort(candidates.begin(), candidates.end());
   candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
