@@ -110,7 +110,7 @@ struct RequestLimits {
   std::size_t max_predicted_paths{16};         // per object
   std::size_t max_predicted_path_points{200};  // per predicted path
   std::size_t max_route_lanelets{1000};
-  std::size_t max_grid_cells{16u * 1024u * 1024u};
+  std::size_t max_grid_cells{std::size_t{16} * 1024 * 1024};
   double max_deadline_ms{10000.0};
 };
 
