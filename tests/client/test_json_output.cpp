@@ -85,7 +85,9 @@ TEST(JsonOutput, FoundPlanHasEveryField) {
   }
   EXPECT_EQ(j["found"], true);
   EXPECT_EQ(j["planner"], "shift");
-  EXPECT_EQ(j["state"], "executing");
+  EXPECT_EQ(j["state"], "waiting_approval");
+  EXPECT_EQ(j["stop_reason"], "waiting approval");
+  EXPECT_EQ(j["safe"], true);
   ASSERT_EQ(j["segments"].size(), 2u);
   EXPECT_EQ(j["segments"][0]["points"], 4);
   EXPECT_EQ(j["segments"][0]["direction"], "reverse");
@@ -105,7 +107,8 @@ TEST(JsonOutput, FoundPlanHasEveryField) {
   EXPECT_EQ(j["error"], "");
   EXPECT_EQ(exit_code(report), 0);
   // Keys in the documented order; a round trip through text gives the same object.
-  EXPECT_EQ(j.dump().rfind("{\"found\":true,\"planner\":\"shift\",\"state\":\"executing\",\"segments\":", 0), 0u)
+  EXPECT_EQ(j.dump().rfind("{\"found\":true,\"planner\":\"shift\",\"state\":\"waiting_approval\",\"stop_reason\":", 0),
+            0u)
       << j.dump();
   EXPECT_EQ(nlohmann::ordered_json::parse(j.dump()), j);
 }

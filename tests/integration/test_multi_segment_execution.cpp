@@ -93,8 +93,9 @@ TEST_F(MultiSegmentExecution, ReverseThenTwoArcsOutOfATightParallelSpot) {
   EXPECT_LT(path->partial_paths[0].points.front().longitudinal_velocity_mps, 0.0);
   EXPECT_LT(path->pairs_terminal_velocity_and_accel[0].velocity_mps, 0.0);
   EXPECT_GT(path->pairs_terminal_velocity_and_accel[1].velocity_mps, 0.0);
+  // Found, not yet approved: the vehicle stands until its first approved progress sample.
   const auto executing = client->wait_for_status(
-      id, [](const PullOutStatus& s) { return s.state == ExecutionState::kExecuting; }, kReplyTimeout);
+      id, [](const PullOutStatus& s) { return s.state == ExecutionState::kWaitingApproval; }, kReplyTimeout);
   ASSERT_TRUE(executing);
   EXPECT_EQ(executing->current_path_idx, 0u);
   EXPECT_EQ(executing->segment_count, 3u);
