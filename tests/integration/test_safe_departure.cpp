@@ -145,7 +145,8 @@ TEST_F(SafeDeparture, CarAppearingAfterDepartureStopsThenResumes) {
   // Drive a few metres at 2 m/s.
   const auto& points = path->partial_paths[0].points;
   std::size_t at = 0;
-  while (at + 1 < points.size() && std::hypot(points[at].pose.x - points[0].pose.x, points[at].pose.y - points[0].pose.y) < 6.0) {
+  while (at + 1 < points.size() &&
+         std::hypot(points[at].pose.x - points[0].pose.x, points[at].pose.y - points[0].pose.y) < 6.0) {
     ++at;
     report(*client, id, points[at].pose, 2.0, true, 500'000'000);
   }
@@ -211,6 +212,48 @@ TEST_F(SafeDeparture, CarAppearingAfterDepartureStopsThenResumes) {
                p->partial_paths[0].points[far].longitudinal_velocity_mps == points[far].longitudinal_velocity_mps;
       },
       3000ms));
+}
+
+TEST_F(SafeDeparture, ReSentRequestKeepsTheSegmentIndexOfALatchedMultiSegmentPath) {
+  start_service();
+  Scenario scenario = load_test_scenario("parallel_spot_reverse");
+  auto client = connect("int-latched");
+  ASSERT_NE(client, nullptr);
+  const std::uint64_t id = client->send(scenario.request);
+  const auto path = client->wait_for_path(id, kReplyTimeout);
+  ASSERT_TRUE(path && path->found);
+  ASSERT_EQ(path->partial_paths.size(), 3u) << "reverse, arc 1, arc 2";
+  ASSERT_TRUE(report_until(*client, id, scenario.request.ego_pose, 0.0, ExecutionState::kExecuting));
+
+  // Drive the reverse leg to its end and stand there until the service moves to segment 1.
+  const auto stand_until = [&](std::uint64_t rid, const Pose2& pose, std::uint32_t idx) {
+    for (int i = 0; i < 60; ++i) {
+      report(*client, rid, pose, 0.0, true, 500'000'000);
+      const auto st = client->latest_status();
+      if (st && st->request_id == rid && st->current_path_idx == idx) return true;
+    }
+    return false;
+  };
+  const Pose2 end0 = path->partial_paths[0].points.back().pose;
+  report(*client, id, path->partial_paths[0].points[1].pose, -1.0, true);
+  ASSERT_TRUE(stand_until(id, end0, 1u));
+
+  // The vehicle re-sends its request from there: latched, the index stays 1 under the new id.
+  scenario.request.ego_pose = end0;
+  const std::uint64_t id2 = client->send(scenario.request);
+  const auto path2 = client->wait_for_path(id2, kReplyTimeout);
+  ASSERT_TRUE(path2 && path2->found);
+  ASSERT_EQ(path2->partial_paths.size(), 3u);
+  EXPECT_EQ(path2->partial_paths[1].points.size(), path->partial_paths[1].points.size());
+  const auto st = client->wait_for_status(
+      id2, [](const PullOutStatus& s) { return s.current_path_idx == 1u; }, kReplyTimeout);
+  ASSERT_TRUE(st);
+  EXPECT_EQ(st->state, ExecutionState::kExecuting);
+  EXPECT_EQ(client->current_segment(), std::optional<std::uint32_t>(1u));
+
+  // And it keeps counting with the new id: the end of arc 1 leads to segment 2.
+  report(*client, id2, path->partial_paths[1].points[1].pose, 1.0, true);
+  ASSERT_TRUE(stand_until(id2, path->partial_paths[1].points.back().pose, 2u));
 }
 
 }  // namespace

@@ -4,12 +4,12 @@
 
 #include <cmath>
 
+#include "pullout/config/scenario.hpp"
 #include "pullout/pipeline/deadline.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "pullout/safety/rss_check.hpp"
 #include "pullout/safety/safety_monitor.hpp"
 #include "pullout/safety/stop_path.hpp"
-#include "pullout/config/scenario.hpp"
 #include "test_world.hpp"
 
 namespace pullout {
@@ -42,9 +42,9 @@ TEST(RssDistance, FormulaWithDefaults) {
 TEST(EgoPrediction, WaitsThenAcceleratesToTheTerminalVelocity) {
   const EgoPredictedPathParameters p;  // delay 1 s, step 0.5 s, horizons 10 s
   const auto path = predict_ego_motion(x_axis(), {10.0, 0.0, 0.0}, 0.0, 2.0, 1.0, p);
-  ASSERT_EQ(path.size(), 20u);  // t = 0, 0.5, ..., 9.5
-  EXPECT_DOUBLE_EQ(path[1].pose.x, 10.0);  // t = 0.5: still waiting
-  EXPECT_DOUBLE_EQ(path[2].pose.x, 10.0);  // t = 1.0: departs now
+  ASSERT_EQ(path.size(), 20u);              // t = 0, 0.5, ..., 9.5
+  EXPECT_DOUBLE_EQ(path[1].pose.x, 10.0);   // t = 0.5: still waiting
+  EXPECT_DOUBLE_EQ(path[2].pose.x, 10.0);   // t = 1.0: departs now
   EXPECT_NEAR(path[4].pose.x, 10.5, 1e-9);  // t = 2: 0.5 * 1 * 1^2
   EXPECT_NEAR(path[4].velocity, 1.0, 1e-9);
   EXPECT_NEAR(path[6].pose.x, 12.0, 1e-9);  // t = 3: reaches 2 m/s after 2 m
@@ -68,8 +68,8 @@ class RssCheck : public ::testing::Test {
  protected:
   RssVerdict check(const Object& object) const {
     const auto ego = predict_ego_motion(x_axis(), {10.0, 0.0, 0.0}, 0.0, 2.0, 1.0, EgoPredictedPathParameters{});
-    return check_rss(ego, vehicle_footprint(VehicleInfo{}), {object}, TargetFilteringParameters{},
-                     SafetyCheckParams{}, 1.0);
+    return check_rss(ego, vehicle_footprint(VehicleInfo{}), {object}, TargetFilteringParameters{}, SafetyCheckParams{},
+                     1.0);
   }
 };
 
@@ -217,7 +217,8 @@ TEST(SafetyMonitor, NoCheckInReverse) {
 TEST(SafetyMonitor, PlannedShiftPathAgainstTraffic) {
   PullOutRequest request = test::straight_shoulder_request();
   request.lanes = long_lanes();
-  const PlanningResult r = StartPlanner(VehicleInfo{}, StartPlannerParameters{}).plan(request, Deadline::after_ms(1000));
+  const PlanningResult r =
+      StartPlanner(VehicleInfo{}, StartPlannerParameters{}).plan(request, Deadline::after_ms(1000));
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound);
   SafetyMonitor m(StartPlannerParameters{}, VehicleInfo{}, long_lanes(), {car(1, -20.0, 0.0, 10.0)}, r.path);
   EXPECT_FALSE(m.evaluate(request.ego_pose, 0.0, 0, false).safe);
@@ -291,6 +292,26 @@ TEST(TrafficScenarios, CannotPassIsTheBypassNotTheCheck) {
   strict.skip_rear_vehicle_check = true;
   SafetyMonitor s(strict, sc.vehicle, sc.request.lanes, sc.request.objects, r.path);
   EXPECT_FALSE(s.evaluate(sc.request.ego_pose, 0.0, 0, false).safe);
+}
+
+}  // namespace
+}  // namespace pullout
+
+namespace pullout {
+namespace {
+
+TEST(SafetyMonitor, HysteresisWidensTheMarginsOnceUnsafe) {
+  StartPlannerParameters p;
+  p.path_safety_check.safety_check_params.hysteresis_factor_expand_rate = 2.0;
+  // A car 10 m behind on the road at y = -1: its box grown sideways by 2 m reaches
+  // y = -1 + 0.95 + 2 = 1.95, short of the ego's right side on the shoulder (3.25 - 0.948 = 2.302);
+  // grown by 4 m (factor 2) it reaches 3.95.
+  const Object beside = car(2, 0.0, -1.0, 10.0);
+  EXPECT_TRUE(monitor({beside}, straight_path(3.25), p).evaluate({10.0, 3.25, 0.0}, 0.0, 0, true).safe);
+  auto m = monitor({car(1, -20.0, 0.0, 10.0)}, straight_path(3.25), p);
+  ASSERT_FALSE(m.evaluate({10.0, 3.25, 0.0}, 0.0, 0, true).safe);
+  m.update_objects({beside});
+  EXPECT_FALSE(m.evaluate({10.0, 3.25, 0.0}, 0.0, 0, true).safe);  // previously unsafe: factor 2
 }
 
 }  // namespace

@@ -28,8 +28,7 @@ double travelled(double v0, double a, double v_min, double v_max, double tau) {
 
 // The rectangle of a vehicle/object body of `length` x `width` around `pose` (centre offset
 // `center_x` ahead of the pose), grown forward by `forward` and sideways by `lateral`.
-Polygon extended_box(const Pose2& pose, double front, double rear, double half_width, double forward,
-                     double lateral) {
+Polygon extended_box(const Pose2& pose, double front, double rear, double half_width, double forward, double lateral) {
   const double f = front + forward;
   const double w = half_width + lateral;
   return {to_global(pose, {f, w}), to_global(pose, {-rear, w}), to_global(pose, {-rear, -w}), to_global(pose, {f, -w})};
@@ -128,14 +127,13 @@ std::vector<TimedPose> sample_object_path(const Object& object, const PredictedP
 double rss_distance(double v_front, double v_rear, const RssParameters& p) {
   const double b_rear = std::abs(p.rear_vehicle_deceleration);
   const double b_front = std::abs(p.front_vehicle_deceleration);
-  return v_rear * (p.rear_vehicle_reaction_time + p.rear_vehicle_safety_time_margin) + v_rear * v_rear / (2.0 * b_rear) -
-         v_front * v_front / (2.0 * b_front);
+  return v_rear * (p.rear_vehicle_reaction_time + p.rear_vehicle_safety_time_margin) +
+         v_rear * v_rear / (2.0 * b_rear) - v_front * v_front / (2.0 * b_front);
 }
 
 double rss_longitudinal_offset(double v_front, double v_rear, double v_ego, double v_object, const RssParameters& p) {
-  const double d_min =
-      p.longitudinal_velocity_delta_time * std::max(std::abs(v_ego), std::abs(v_object)) +
-      p.longitudinal_distance_min_threshold;
+  const double d_min = p.longitudinal_velocity_delta_time * std::max(std::abs(v_ego), std::abs(v_object)) +
+                       p.longitudinal_distance_min_threshold;
   return std::max(rss_distance(v_front, v_rear, p), d_min);
 }
 
@@ -212,9 +210,9 @@ RssVerdict check_rss(const std::vector<TimedPose>& ego_path, const Footprint& eg
         if (!check_path(object, &path)) return verdict;
       }
     } else {
-      const auto best = std::max_element(
-          object.predicted_paths.begin(), object.predicted_paths.end(),
-          [](const PredictedPath& a, const PredictedPath& b) { return a.confidence < b.confidence; });
+      const auto best =
+          std::max_element(object.predicted_paths.begin(), object.predicted_paths.end(),
+                           [](const PredictedPath& a, const PredictedPath& b) { return a.confidence < b.confidence; });
       if (!check_path(object, &*best)) return verdict;
     }
   }

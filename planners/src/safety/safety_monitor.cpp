@@ -175,8 +175,8 @@ SafetyVerdict SafetyMonitor::evaluate(const Pose2& ego, double velocity, std::ui
   const double accel = std::max(pair.accel_mps2, ego_params.min_acceleration);
   const auto ego_path = predict_ego_motion(line, ego, v0, max_velocity, accel, ego_params);
   const double hysteresis = previous_safe_ ? 1.0 : check.hysteresis_factor_expand_rate;
-  const RssVerdict rss = check_rss(ego_path, footprint_, targets(ego), parameters_.path_safety_check.target_filtering,
-                                   check, hysteresis);
+  const RssVerdict rss =
+      check_rss(ego_path, footprint_, targets(ego), parameters_.path_safety_check.target_filtering, check, hysteresis);
   verdict.rss_checked = true;
   verdict.safe = rss.safe;
   verdict.object_id = rss.object_id;

@@ -8,8 +8,8 @@
 
 namespace pullout {
 
-PullOutPath insert_feasible_stop(const PullOutPath& path, std::uint32_t segment_idx, const Pose2& ego,
-                                 double velocity, const StopConditionParameters& p) {
+PullOutPath insert_feasible_stop(const PullOutPath& path, std::uint32_t segment_idx, const Pose2& ego, double velocity,
+                                 const StopConditionParameters& p) {
   PullOutPath out = path;
   if (out.partial_paths.empty()) return out;
   const auto idx = std::min<std::size_t>(segment_idx, out.partial_paths.size() - 1);

@@ -125,6 +125,12 @@ std::optional<PlanningJob> VehicleRegistry::accept(PullOutRequest request) {
       return std::nullopt;
     }
   }
+  // A re-plan before departure for the same goal keeps the turn signal's start (below), so that
+  // periodic re-plans do not restart prepare_time_before_start.
+  const bool same_situation = has_path(v->status.state) && !v->status.departed && same_goal(v->goal, request.goal_pose);
+  v->signal_carry = same_situation
+                        ? std::make_optional(std::make_pair(v->status.turn_signal, v->status.turn_signal_start_ns))
+                        : std::nullopt;
   supersede(*v);
   v->goal = request.goal_pose;
   v->planned_at = now;
@@ -173,6 +179,9 @@ bool VehicleRegistry::complete(const PlanningJob& job, const PlanningResult& res
       status.stop_reason = "waiting approval";
       status.current_path_idx = 0;
       status.turn_signal = path.turn_signal;
+      if (v->signal_carry && v->signal_carry->first == path.turn_signal) {
+        status.turn_signal_start_ns = v->signal_carry->second;
+      }
       break;
     case PlanningResult::Outcome::kNoPath:
       path = result.path;

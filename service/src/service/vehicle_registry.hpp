@@ -17,7 +17,9 @@
 // th_arrived_distance of the path's first point; it only replaces the
 // objects of the safety check, and the current path (as published: with or without the stop) is
 // re-published under the new request id, keeping the segment index (ExecutionTracker::adopt).
-// Otherwise it replaces the path (a new search).
+// Otherwise it replaces the path (a new search); before departure, a new path for the same goal
+// with the same turn signal keeps the signal's start, so periodic re-plans do not restart the
+// prepare time.
 //
 // Per vehicle, everything happens under that vehicle's lock, so the samples of one vehicle are
 // published in a consistent order (kPlanning before the result, a result only if no newer request
@@ -31,6 +33,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "pullout/model/types.hpp"
@@ -97,6 +100,8 @@ class VehicleRegistry {
     std::optional<SafetyMonitor> safety;  // of `path`
     bool stop_inserted{false};            // the published path is `path` with a stop
     PullOutPath published;                // what was published last for `path`
+    // Turn signal and its start carried from the path a same-goal re-plan replaces.
+    std::optional<std::pair<TurnSignal, std::int64_t>> signal_carry;
   };
 
   std::shared_ptr<Vehicle> find(const std::string& vehicle_id) const;

@@ -37,10 +37,10 @@ namespace pullout {
 
 struct SafetyVerdict {
   bool safe{true};
-  bool rss_checked{false};        // the RSS check ran (forward segment, enabled, not bypassed)
-  bool preventing_rear{false};    // the ego blocks the lane for a vehicle from behind
-  std::int64_t object_id{0};      // the object that made it unsafe
-  std::string reason;             // "nearby moving object risk: ...", "dynamic object risk: ..."
+  bool rss_checked{false};      // the RSS check ran (forward segment, enabled, not bypassed)
+  bool preventing_rear{false};  // the ego blocks the lane for a vehicle from behind
+  std::int64_t object_id{0};    // the object that made it unsafe
+  std::string reason;           // "nearby moving object risk: ...", "dynamic object risk: ..."
 };
 
 class SafetyMonitor {

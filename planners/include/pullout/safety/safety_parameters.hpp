@@ -36,14 +36,14 @@ struct EgoPredictedPathParameters {
 
 // Which objects are safety targets and how their predicted paths are sampled.
 struct TargetFilteringParameters {
-  double safety_check_time_horizon{10.0};        // [s] predicted paths are cut here
-  double safety_check_time_resolution{1.0};      // [s] predicted paths are resampled at this step
-  double object_check_forward_distance{10.0};    // [m] ahead of the ego, along the lane
-  double object_check_backward_distance{100.0};  // [m] behind the ego, along the lane
+  double safety_check_time_horizon{10.0};         // [s] predicted paths are cut here
+  double safety_check_time_resolution{1.0};       // [s] predicted paths are resampled at this step
+  double object_check_forward_distance{10.0};     // [m] ahead of the ego, along the lane
+  double object_check_backward_distance{100.0};   // [m] behind the ego, along the lane
   double ignore_object_velocity_threshold{0.25};  // [m/s] slower objects are not targets
   SafetyObjectTypes object_types_to_check;
-  bool check_current_lane{true};   // objects on the road lanes the path merges into
-  bool check_shoulder_lane{true};  // objects on road shoulders
+  bool check_current_lane{true};      // objects on the road lanes the path merges into
+  bool check_shoulder_lane{true};     // objects on road shoulders
   bool use_all_predicted_path{true};  // false: only the most confident predicted path
 };
 
@@ -53,19 +53,19 @@ enum class ExtendedPolygonPolicy : std::uint8_t { kAlongPath = 0, kRectangle = 1
 //   d_rss = v_rear (t_react + t_margin) + v_rear^2 / (2 |b_rear|) - v_front^2 / (2 |b_front|)
 // and the minimum d_min = longitudinal_velocity_delta_time * max(v) + longitudinal_distance_min_threshold.
 struct RssParameters {
-  double rear_vehicle_reaction_time{2.0};            // [s]
-  double rear_vehicle_safety_time_margin{1.0};       // [s]
-  double lateral_distance_max_threshold{2.0};        // [m]
-  double longitudinal_distance_min_threshold{3.0};   // [m]
-  double longitudinal_velocity_delta_time{0.8};      // [s]
-  double front_vehicle_deceleration{-1.0};           // [m/s^2] < 0
-  double rear_vehicle_deceleration{-1.0};            // [m/s^2] < 0
+  double rear_vehicle_reaction_time{2.0};           // [s]
+  double rear_vehicle_safety_time_margin{1.0};      // [s]
+  double lateral_distance_max_threshold{2.0};       // [m]
+  double longitudinal_distance_min_threshold{3.0};  // [m]
+  double longitudinal_velocity_delta_time{0.8};     // [s]
+  double front_vehicle_deceleration{-1.0};          // [m/s^2] < 0
+  double rear_vehicle_deceleration{-1.0};           // [m/s^2] < 0
   ExtendedPolygonPolicy extended_polygon_policy{ExtendedPolygonPolicy::kAlongPath};
 };
 
 struct SafetyCheckParams {
   bool enable_safety_check{true};
-  double hysteresis_factor_expand_rate{1.0};        // >= 1: margins grow by this once unsafe
+  double hysteresis_factor_expand_rate{1.0};         // >= 1: margins grow by this once unsafe
   double collision_check_yaw_diff_threshold{1.578};  // [rad] objects heading more apart are skipped
   RssParameters rss_params;
 };

@@ -14,7 +14,7 @@ namespace pullout {
 // odometry. The result keeps every field of `path` except the velocities (and terminal pairs of
 // the current and later segments, set to (0, 0)). Distance along the segment is measured from the
 // projection of `ego`; points behind it keep min(their speed, |velocity|).
-PullOutPath insert_feasible_stop(const PullOutPath& path, std::uint32_t segment_idx, const Pose2& ego,
-                                 double velocity, const StopConditionParameters& p);
+PullOutPath insert_feasible_stop(const PullOutPath& path, std::uint32_t segment_idx, const Pose2& ego, double velocity,
+                                 const StopConditionParameters& p);
 
 }  // namespace pullout
