@@ -4,7 +4,9 @@
 // under the same request id, then the original path again once safe and stopped).
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <thread>
@@ -254,6 +256,42 @@ TEST_F(SafeDeparture, ReSentRequestKeepsTheSegmentIndexOfALatchedMultiSegmentPat
   // And it keeps counting with the new id: the end of arc 1 leads to segment 2.
   report(*client, id2, path->partial_paths[1].points[1].pose, 1.0, true);
   ASSERT_TRUE(stand_until(id2, path->partial_paths[1].points.back().pose, 2u));
+}
+
+TEST_F(SafeDeparture, TurnSignalIsOnForThePrepareTimeBeforeDeparture) {
+  // The shipped config with prepare_time_before_start: 2 s (profiles path made absolute).
+  std::ifstream in(default_config_path());
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace("prepare_time_before_start: 0.0", "prepare_time_before_start: 2.0");
+  replace("profiles_file: dds/loopback.xml", "profiles_file: " + loopback_profiles_path());
+  start_service(temp_.write_file("pullout.yaml", text));
+
+  const Scenario scenario = load_test_scenario("straight_shoulder");
+  auto client = connect("int-prepare");
+  ASSERT_NE(client, nullptr);
+  const std::uint64_t id = client->send(scenario.request);
+  ASSERT_TRUE(client->wait_for_path(id, kReplyTimeout));
+  // Approved at t0: the signal comes on, departure waits 2 s on the progress clock.
+  report(*client, id, scenario.request.ego_pose, 0.0, true);
+  const std::int64_t t0 = stamp_ns_;
+  ASSERT_TRUE(eventually(
+      [&] {
+        const auto st = client->latest_status();
+        return st && st->state == ExecutionState::kWaitingSafety;
+      },
+      3000ms));
+  EXPECT_EQ(client->latest_status()->stop_reason, "turn signal prepare time");
+  EXPECT_EQ(client->latest_status()->turn_signal_start_ns, t0);
+  report(*client, id, scenario.request.ego_pose, 0.0, true, 1'500'000'000);  // t0 + 1.5 s
+  EXPECT_EQ(client->latest_status()->state, ExecutionState::kWaitingSafety);
+  const auto go = report_until(*client, id, scenario.request.ego_pose, 0.0, ExecutionState::kExecuting);
+  ASSERT_TRUE(go);
+  EXPECT_GE(stamp_ns_ - t0, 2'000'000'000);
 }
 
 }  // namespace
