@@ -205,3 +205,29 @@ TEST(TextOutput, RejectedShowsEachErrorLine) {
 
 }  // namespace
 }  // namespace pullout::cli
+
+namespace pullout::cli {
+namespace {
+
+TEST(JsonOutput, WaitingForSafetyIsAFoundPathWithTheReason) {
+  PullOutStatus status;
+  status.request_id = 8;
+  status.state = ExecutionState::kWaitingSafety;
+  status.stop_reason = "dynamic object risk: RSS distance to rear object 21 at t = 0.0 s";
+  status.safe = false;
+  status.unsafe_object_id = 21;
+  status.turn_signal = TurnSignal::kRight;
+  PullOutPath path = two_segment_path();
+  path.found = true;
+  const PlanReport report = make_report(path, status);
+  const nlohmann::ordered_json j = to_json(report);
+  EXPECT_EQ(j["found"], true);
+  EXPECT_EQ(j["state"], "waiting_safety");
+  EXPECT_EQ(j["stop_reason"], status.stop_reason);
+  EXPECT_EQ(j["turn_signal"], "right");
+  EXPECT_EQ(j["safe"], false);
+  EXPECT_EQ(exit_code(report), 0);
+}
+
+}  // namespace
+}  // namespace pullout::cli
