@@ -87,6 +87,17 @@ TEST_F(RssCheck, FarCarIsSafe) {
   EXPECT_TRUE(check(car(7, -200.0, 0.0, 10.0)).safe);
 }
 
+TEST_F(RssCheck, SlowCarAheadIsUnsafeOnceTheEgoCatchesUp) {
+  // Car ahead at 0.5 m/s, rear at 25 - 2.25 = 22.75 m. At t = 0 the ego's front (13.79) plus
+  // d_min (0.8 * 0.5 + 3 = 3.4) stays short of it; at t = 4 s the ego is at 14 m doing 2 m/s:
+  // d_rss = 2 * 3 + 2 - 0.125 = 7.875, 17.79 + 7.875 = 25.67 > 24.75 (the car has moved 2 m).
+  const RssVerdict v = check(car(8, 25.0, 0.0, 0.5));
+  EXPECT_FALSE(v.safe);
+  EXPECT_GT(v.time_s, 0.0);
+  EXPECT_LE(v.time_s, 4.0);
+  EXPECT_NE(v.reason.find("front"), std::string::npos) << v.reason;
+}
+
 TEST_F(RssCheck, LateralThreshold) {
   // Rear car (extended 80 m forward) beside the ego: unsafe while its side, grown by 2 m,
   // reaches the ego's side: y - 0.95 - 2.0 <= 0.948, i.e. y <= 3.898 m.
