@@ -540,7 +540,7 @@ std::optional<std::uint32_t> Client::Impl::current_segment() const {
   for (auto it = recent_statuses_.rbegin(); it != recent_statuses_.rend(); ++it) {
     const PullOutStatus& status = *it->value;
     if (status.request_id != current_request_id_) continue;
-    if (status.state == ExecutionState::kExecuting || status.state == ExecutionState::kCompleted) {
+    if (has_path(status.state)) {
       return status.current_path_idx;
     }
     return std::nullopt;

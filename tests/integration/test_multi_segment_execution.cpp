@@ -105,8 +105,9 @@ TEST_F(MultiSegmentExecution, ReverseThenTwoArcsOutOfATightParallelSpot) {
   EXPECT_LT(p.path->partial_paths[0].points.front().longitudinal_velocity_mps, 0.0);
   EXPECT_LT(p.path->pairs_terminal_velocity_and_accel[0].velocity_mps, 0.0);
   EXPECT_GT(p.path->pairs_terminal_velocity_and_accel[1].velocity_mps, 0.0);
+  // Found, not yet approved: the vehicle stands until its first approved progress sample.
   const auto executing = p.client->wait_for_status(
-      p.id, [](const PullOutStatus& s) { return s.state == ExecutionState::kExecuting; }, kReplyTimeout);
+      p.id, [](const PullOutStatus& s) { return s.state == ExecutionState::kWaitingApproval; }, kReplyTimeout);
   ASSERT_TRUE(executing);
   EXPECT_EQ(executing->current_path_idx, 0u);
   EXPECT_EQ(executing->segment_count, 3u);

@@ -51,7 +51,7 @@ TEST_F(PullOutFlow, StraightShoulderIsPlannedAndExecutedToCompletion) {
   EXPECT_EQ(path->planner_type, PlannerType::kShift);
 
   const auto executing = client->wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
   ASSERT_TRUE(executing) << "latest status: "
                          << (client->latest_status() ? static_cast<int>(client->latest_status()->state) : -1);
   EXPECT_EQ(executing->current_path_idx, 0u);
@@ -126,7 +126,7 @@ TEST_F(PullOutFlow, ClientStartedAfterTheReplyGetsTheLatestPath) {
     ASSERT_TRUE(path->found);
     segments = path->partial_paths.size();
     ASSERT_TRUE(first->wait_for_status(
-        id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout));
+        id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout));
   }  // the first client is gone: only the service's transient-local history has the reply now
 
   // The second client takes its QoS from the shipped profiles file (the first used the built-in
@@ -143,7 +143,7 @@ TEST_F(PullOutFlow, ClientStartedAfterTheReplyGetsTheLatestPath) {
   // A restarted client adopts the request the service last answered.
   EXPECT_EQ(second->current_request_id(), id);
   const auto status = second->wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
   ASSERT_TRUE(status);
   EXPECT_EQ(second->current_segment(), std::optional<std::uint32_t>(0u));
 }
@@ -268,7 +268,7 @@ TEST_F(PullOutFlow, FiveThousandPointPathArrives) {
   EXPECT_LT(elapsed, kBound) << "took " << std::chrono::duration_cast<std::chrono::milliseconds>(elapsed).count()
                              << " ms";
   const auto status = client->wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
   ASSERT_TRUE(status);
   EXPECT_EQ(status->segment_count, path->partial_paths.size());
 }
@@ -336,7 +336,7 @@ TEST_F(PullOutFlow, TwentyVehiclesAtOnceAreAllServed) {
   // And each vehicle's status is its own.
   for (int i = 0; i < kVehicles; ++i) {
     const auto status = clients[i]->wait_for_status(
-        ids[i], [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
+        ids[i], [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
     EXPECT_TRUE(status) << clients[i]->vehicle_id();
   }
 }
