@@ -254,12 +254,16 @@ E2eResult measure_e2e(const pullout::Scenario& scenario, int domain, int warmup,
   if (!client.wait_for_service(kMatchTimeout)) throw std::runtime_error("the client did not match the service");
   E2eResult r;
   const auto executing = [](const pullout::PullOutStatus& s) {
-    return s.state == pullout::ExecutionState::kExecuting || s.state == pullout::ExecutionState::kNoPath ||
+    return s.state == pullout::ExecutionState::kWaitingApproval || s.state == pullout::ExecutionState::kNoPath ||
            s.state == pullout::ExecutionState::kRejected;
   };
   for (int i = 0; i < warmup + requests; ++i) {
+    // Alternate the goal by 0.5 m: a re-sent request for the same goal within
+    // backward_path_update_duration would only update the objects, not plan.
+    pullout::PullOutRequest request = scenario.request;
+    request.goal_pose.x += (i % 2) * 0.5;
     const auto t0 = SteadyClock::now();
-    const std::uint64_t id = client.send(scenario.request);
+    const std::uint64_t id = client.send(request);
     const auto path = client.wait_for_path(id, kReplyTimeout);
     const double latency = ms_since(t0);
     // The final status follows the path; wait for it so that requests never overlap.

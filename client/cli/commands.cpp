@@ -178,7 +178,7 @@ int run_request(const RequestOptions& options, std::ostream& out, std::ostream& 
     const auto path_deadline = std::max(deadline, SteadyClock::now() + kPathGrace);
     path = wait_sliced(path_deadline, [&](Client::Duration slice) { return client->wait_for_path(request_id, slice); });
     if (g_interrupted.load()) return kExitInterrupted;
-    const bool executing = status->state == ExecutionState::kExecuting || status->state == ExecutionState::kCompleted;
+    const bool executing = has_path(status->state);
     if (!path && executing) {
       err << "pullout: the service reported a path for request " << request_id << " but it did not arrive\n";
       return kExitCommunication;

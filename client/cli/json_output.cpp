@@ -38,6 +38,9 @@ nlohmann::ordered_json to_json(const PlanReport& report) {
   out["found"] = report.found;
   out["planner"] = to_string(report.planner);
   out["state"] = to_string(report.state);
+  out["stop_reason"] = report.stop_reason;
+  out["turn_signal"] = to_string(report.turn_signal);
+  out["safe"] = report.safe;
   out["segments"] = std::move(segments);
   out["start_pose"] = report.path ? pose(report.path->start_pose) : Json(nullptr);
   out["end_pose"] = report.path ? pose(report.path->end_pose) : Json(nullptr);

@@ -3,7 +3,12 @@
 //   {
 //     "found": true,
 //     "planner": "shift",                     // pullout::to_string(PlannerType)
-//     "state": "executing",                   // pullout::to_string(ExecutionState)
+//     "state": "waiting_approval",            // pullout::to_string(ExecutionState): planning,
+//                                             // rejected, no_path, waiting_approval,
+//                                             // waiting_safety, executing, completed
+//     "stop_reason": "waiting approval",       // why the vehicle must stand ("" when executing)
+//     "turn_signal": "right",                  // none | left | right
+//     "safe": true,                            // dynamic safety at the last progress sample
 //     "segments": [{"points": 42, "direction": "forward" | "reverse",
 //                   "terminal_velocity": 2.7, "terminal_acceleration": 0.0,   // null if unknown
 //                   "length": 40.1}],          // [m/s], [m/s^2], [m]

@@ -66,7 +66,9 @@ PlanReport make_report(const PlanningResult& result) {
   switch (result.outcome) {
     case PlanningResult::Outcome::kFound:
       report.found = true;
-      report.state = ExecutionState::kExecuting;
+      report.state = ExecutionState::kWaitingApproval;
+      report.stop_reason = "waiting approval";
+      report.turn_signal = result.path.turn_signal;
       break;
     case PlanningResult::Outcome::kNoPath:
       report.state = ExecutionState::kNoPath;
@@ -99,10 +101,12 @@ PlanReport make_report(const std::optional<PullOutPath>& path, const PullOutStat
   report.planning_time_ms = status.planning_time_ms;
   report.error = status.error;
   report.planner = status.planner_type;
-  const bool executing = status.state == ExecutionState::kExecuting || status.state == ExecutionState::kCompleted;
+  report.stop_reason = status.stop_reason;
+  report.turn_signal = status.turn_signal;
+  report.safe = status.safe;
   if (path) {
     report.path = path;
-    report.found = path->found && executing;
+    report.found = path->found && has_path(status.state);
     if (path->planner_type != PlannerType::kNone) report.planner = path->planner_type;
     report.segments = summarize_segments(*path);
     if (!report.found) {

@@ -27,8 +27,13 @@ struct PlanReport {
   bool found{false};
   PlannerType planner{PlannerType::kNone};
   // The service's state for this request; for an in-process plan, the state the service would
-  // publish: executing (found), no_path or rejected.
+  // publish: waiting_approval (found), no_path or rejected.
   ExecutionState state{ExecutionState::kIdle};
+  // Why the vehicle must stand (waiting_approval, waiting_safety, no_path), the turn signal of
+  // the path and the dynamic safety at the service's last progress sample.
+  std::string stop_reason;
+  TurnSignal turn_signal{TurnSignal::kNone};
+  bool safe{true};
   // The path (the stop path when nothing was found); absent for a rejected request or when the
   // service sent none.
   std::optional<PullOutPath> path;

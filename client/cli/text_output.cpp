@@ -41,6 +41,12 @@ void print_lines(std::ostream& out, const std::string& text, const char* prefix)
 void print_report(std::ostream& out, const PlanReport& report) {
   out << "found: " << (report.found ? "yes" : "no") << "   planner: " << to_string(report.planner)
       << "   state: " << to_string(report.state) << '\n';
+  if (report.found) {
+    out << "turn signal: " << to_string(report.turn_signal) << "   safe: " << (report.safe ? "yes" : "no") << '\n';
+  }
+  if (!report.stop_reason.empty() && report.state != ExecutionState::kNoPath) {
+    out << "waiting: " << report.stop_reason << '\n';
+  }
 
   if (report.state == ExecutionState::kRejected) {
     out << "request rejected:\n";

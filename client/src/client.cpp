@@ -46,7 +46,7 @@ using SteadyClock = std::chrono::steady_clock;
 constexpr std::size_t kMaxVehicleIdBytes = 255;
 constexpr int kMaxDomainId = 232;
 // Replies kept for wait_for_path / wait_for_status. Paths can be several hundred KB each.
-constexpr std::size_t kRecentPaths = 4;
+constexpr std::size_t kRecentPaths = 16;  // client.hpp promises the last 16
 constexpr std::size_t kRecentStatuses = 32;
 // Reader history depths: more than 1 so that replies arriving back to back are not overwritten
 // before the client's thread takes them. Late joiners still get only the writer's last sample.
@@ -540,7 +540,7 @@ std::optional<std::uint32_t> Client::Impl::current_segment() const {
   for (auto it = recent_statuses_.rbegin(); it != recent_statuses_.rend(); ++it) {
     const PullOutStatus& status = *it->value;
     if (status.request_id != current_request_id_) continue;
-    if (status.state == ExecutionState::kExecuting || status.state == ExecutionState::kCompleted) {
+    if (has_path(status.state)) {
       return status.current_path_idx;
     }
     return std::nullopt;
@@ -552,12 +552,16 @@ bool Client::Impl::wait_for_service(Duration timeout) const {
   const auto deadline = deadline_after(timeout);
   while (true) {
     dds::PublicationMatchedStatus request_matched;
+    dds::PublicationMatchedStatus progress_matched;
     dds::SubscriptionMatchedStatus path_matched;
     dds::SubscriptionMatchedStatus status_matched;
     request_writer_->get_publication_matched_status(request_matched);
+    progress_writer_->get_publication_matched_status(progress_matched);
     path_reader_->get_subscription_matched_status(path_matched);
     status_reader_->get_subscription_matched_status(status_matched);
-    if (request_matched.current_count > 0 && path_matched.current_count > 0 && status_matched.current_count > 0) {
+    // Progress is volatile too: a sample written before its writer matched would be lost.
+    if (request_matched.current_count > 0 && progress_matched.current_count > 0 && path_matched.current_count > 0 &&
+        status_matched.current_count > 0) {
       return true;
     }
     const auto now = SteadyClock::now();

@@ -6,18 +6,19 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
+#include "pullout/idl/topics.hpp"
+
 namespace pullout::client_detail {
 
-inline constexpr const char* kRequestTopic = "pullout/request";
-inline constexpr const char* kPathTopic = "pullout/path";
-inline constexpr const char* kStatusTopic = "pullout/status";
-inline constexpr const char* kProgressTopic = "pullout/progress";
-
-// Profile names looked up in a user profiles file (shared with config/dds/*.xml).
-inline constexpr const char* kRequestWriterProfile = "pullout_request_writer";
-inline constexpr const char* kProgressWriterProfile = "pullout_progress_writer";
-inline constexpr const char* kPathReaderProfile = "pullout_path_reader";
-inline constexpr const char* kStatusReaderProfile = "pullout_status_reader";
+// Topic names, and the profile names looked up in a user profiles file (config/dds/*.xml).
+using idl::kPathReaderProfile;
+using idl::kPathTopic;
+using idl::kProgressTopic;
+using idl::kProgressWriterProfile;
+using idl::kRequestTopic;
+using idl::kRequestWriterProfile;
+using idl::kStatusReaderProfile;
+using idl::kStatusTopic;
 
 // Loopback only: built-in transports (UDP on every interface, shared memory) off, one UDPv4
 // transport whitelisted to 127.0.0.1 with 4 MiB socket buffers (large paths, see

@@ -489,6 +489,11 @@ msg::PullOutStatus to_msg(const PullOutStatus& in) {
   out.stop_reason(in.stop_reason);
   out.error(in.error);
   out.planning_time_ms(in.planning_time_ms);
+  out.safe(in.safe);
+  out.unsafe_object_id(in.unsafe_object_id);
+  out.departed(in.departed);
+  out.turn_signal(enum_to_msg<TurnSignal, msg::TurnSignal>(in.turn_signal));
+  out.turn_signal_start(to_msg_time(in.turn_signal_start_ns));
   return out;
 }
 
@@ -497,7 +502,7 @@ PullOutStatus from_msg(const msg::PullOutStatus& in) {
   out.vehicle_id = in.vehicle_id();
   out.request_id = in.request_id();
   out.stamp_ns = from_msg_time(in.stamp());
-  out.state = lenient_enum(in.state(), msg::STATE_COMPLETED, ExecutionState::kIdle);
+  out.state = lenient_enum(in.state(), msg::STATE_WAITING_SAFETY, ExecutionState::kIdle);
   out.current_path_idx = in.current_path_idx();
   out.segment_count = in.segment_count();
   out.planner_type = lenient_enum(in.planner_type(), msg::PLANNER_FREESPACE, PlannerType::kNone);
@@ -513,6 +518,11 @@ PullOutStatus from_msg(const msg::PullOutStatus& in) {
   out.stop_reason = in.stop_reason();
   out.error = in.error();
   out.planning_time_ms = in.planning_time_ms();
+  out.safe = in.safe();
+  out.unsafe_object_id = in.unsafe_object_id();
+  out.departed = in.departed();
+  out.turn_signal = lenient_enum(in.turn_signal(), msg::TURN_SIGNAL_RIGHT, TurnSignal::kNone);
+  out.turn_signal_start_ns = from_msg_time(in.turn_signal_start());
   return out;
 }
 

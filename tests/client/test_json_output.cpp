@@ -85,7 +85,9 @@ TEST(JsonOutput, FoundPlanHasEveryField) {
   }
   EXPECT_EQ(j["found"], true);
   EXPECT_EQ(j["planner"], "shift");
-  EXPECT_EQ(j["state"], "executing");
+  EXPECT_EQ(j["state"], "waiting_approval");
+  EXPECT_EQ(j["stop_reason"], "waiting approval");
+  EXPECT_EQ(j["safe"], true);
   ASSERT_EQ(j["segments"].size(), 2u);
   EXPECT_EQ(j["segments"][0]["points"], 4);
   EXPECT_EQ(j["segments"][0]["direction"], "reverse");
@@ -105,7 +107,8 @@ TEST(JsonOutput, FoundPlanHasEveryField) {
   EXPECT_EQ(j["error"], "");
   EXPECT_EQ(exit_code(report), 0);
   // Keys in the documented order; a round trip through text gives the same object.
-  EXPECT_EQ(j.dump().rfind("{\"found\":true,\"planner\":\"shift\",\"state\":\"executing\",\"segments\":", 0), 0u)
+  EXPECT_EQ(j.dump().rfind("{\"found\":true,\"planner\":\"shift\",\"state\":\"waiting_approval\",\"stop_reason\":", 0),
+            0u)
       << j.dump();
   EXPECT_EQ(nlohmann::ordered_json::parse(j.dump()), j);
 }
@@ -198,6 +201,32 @@ TEST(TextOutput, RejectedShowsEachErrorLine) {
   EXPECT_NE(out.str().find("request rejected:\n  lanes[0].left_bound: fewer than 2 points\n  goal_pose.yaw"),
             std::string::npos)
       << out.str();
+}
+
+}  // namespace
+}  // namespace pullout::cli
+
+namespace pullout::cli {
+namespace {
+
+TEST(JsonOutput, WaitingForSafetyIsAFoundPathWithTheReason) {
+  PullOutStatus status;
+  status.request_id = 8;
+  status.state = ExecutionState::kWaitingSafety;
+  status.stop_reason = "dynamic object risk: RSS distance to rear object 21 at t = 0.0 s";
+  status.safe = false;
+  status.unsafe_object_id = 21;
+  status.turn_signal = TurnSignal::kRight;
+  PullOutPath path = two_segment_path();
+  path.found = true;
+  const PlanReport report = make_report(path, status);
+  const nlohmann::ordered_json j = to_json(report);
+  EXPECT_EQ(j["found"], true);
+  EXPECT_EQ(j["state"], "waiting_safety");
+  EXPECT_EQ(j["stop_reason"], status.stop_reason);
+  EXPECT_EQ(j["turn_signal"], "right");
+  EXPECT_EQ(j["safe"], false);
+  EXPECT_EQ(exit_code(report), 0);
 }
 
 }  // namespace

@@ -372,6 +372,26 @@ TEST(Convert, StatusRoundTrip) {
   EXPECT_EQ(out.error, in.error);
   EXPECT_DOUBLE_EQ(out.planning_time_ms, 12.5);
 
+  // The departure and safety fields.
+  in.state = ExecutionState::kWaitingSafety;
+  in.stop_reason = "dynamic object risk: RSS distance to rear object 21 at t = 0.0 s";
+  in.safe = false;
+  in.unsafe_object_id = 21;
+  in.departed = true;
+  in.turn_signal = TurnSignal::kRight;
+  in.turn_signal_start_ns = 1'700'000'000'123'456'789;
+  const PullOutStatus waiting = from_msg(to_msg(in));
+  EXPECT_EQ(waiting.state, ExecutionState::kWaitingSafety);
+  EXPECT_EQ(waiting.stop_reason, in.stop_reason);
+  EXPECT_FALSE(waiting.safe);
+  EXPECT_EQ(waiting.unsafe_object_id, 21);
+  EXPECT_TRUE(waiting.departed);
+  EXPECT_EQ(waiting.turn_signal, TurnSignal::kRight);
+  EXPECT_EQ(waiting.turn_signal_start_ns, in.turn_signal_start_ns);
+  in.state = ExecutionState::kWaitingApproval;
+  EXPECT_EQ(from_msg(to_msg(in)).state, ExecutionState::kWaitingApproval);
+  in.state = ExecutionState::kExecuting;
+
   // Outbound types are not validated: an unknown state maps to the neutral value.
   msg::PullOutStatus m = to_msg(in);
   m.state(static_cast<msg::ExecutionState>(99));

@@ -34,7 +34,7 @@ std::runtime_error system_error(const std::string& what) {
 
 std::string signal_name(int sig) {
   const char* name = ::strsignal(sig);
-  return name != nullptr ? name : ("signal " + std::to_string(sig));
+  return "signal " + std::to_string(sig) + (name != nullptr ? std::string(" (") + name + ")" : std::string());
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 // current_path_idx change and the completion are checked on the received statuses.
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -18,6 +19,23 @@ using namespace std::chrono_literals;
 
 class MultiSegmentExecution : public ServiceTest {
  protected:
+  struct Planned {
+    std::unique_ptr<Client> client;
+    std::uint64_t id{0};
+    std::optional<PullOutPath> path;  // checked against the path invariants
+  };
+  // Starts the service, sends the scenario as `vehicle` and waits for the path.
+  Planned plan(const std::string& scenario_name, const std::string& vehicle) {
+    start_service();
+    Planned p;
+    p.client = connect(vehicle);
+    if (p.client == nullptr) return p;
+    p.id = p.client->send(load_test_scenario(scenario_name).request);
+    p.path = p.client->wait_for_path(p.id, kReplyTimeout);
+    if (p.path) expect_found_path_invariants(*p.path);
+    return p;
+  }
+
   // Drives the vehicle along every segment of `path`: one odometry sample per path point with
   // the path's (signed) velocity, stamps advancing at that speed; at the end of each segment but
   // the last it stands still (th_stopped_time is 1 s on the stamps) and expects the service to
@@ -80,38 +98,27 @@ class MultiSegmentExecution : public ServiceTest {
 };
 
 TEST_F(MultiSegmentExecution, ReverseThenTwoArcsOutOfATightParallelSpot) {
-  start_service();
-  const Scenario scenario = load_test_scenario("parallel_spot_reverse");
-  auto client = connect("int-multi-arc");
-  ASSERT_NE(client, nullptr);
-  const std::uint64_t id = client->send(scenario.request);
-  const auto path = client->wait_for_path(id, kReplyTimeout);
-  ASSERT_TRUE(path);
-  expect_found_path_invariants(*path);
-  ASSERT_EQ(path->planner_type, PlannerType::kGeometric);
-  ASSERT_EQ(path->partial_paths.size(), 3u) << "reverse, arc 1, arc 2";
-  EXPECT_LT(path->partial_paths[0].points.front().longitudinal_velocity_mps, 0.0);
-  EXPECT_LT(path->pairs_terminal_velocity_and_accel[0].velocity_mps, 0.0);
-  EXPECT_GT(path->pairs_terminal_velocity_and_accel[1].velocity_mps, 0.0);
-  const auto executing = client->wait_for_status(
-      id, [](const PullOutStatus& s) { return s.state == ExecutionState::kExecuting; }, kReplyTimeout);
+  const Planned p = plan("parallel_spot_reverse", "int-multi-arc");
+  ASSERT_TRUE(p.path);
+  ASSERT_EQ(p.path->planner_type, PlannerType::kGeometric);
+  ASSERT_EQ(p.path->partial_paths.size(), 3u) << "reverse, arc 1, arc 2";
+  EXPECT_LT(p.path->partial_paths[0].points.front().longitudinal_velocity_mps, 0.0);
+  EXPECT_LT(p.path->pairs_terminal_velocity_and_accel[0].velocity_mps, 0.0);
+  EXPECT_GT(p.path->pairs_terminal_velocity_and_accel[1].velocity_mps, 0.0);
+  // Found, not yet approved: the vehicle stands until its first approved progress sample.
+  const auto executing = p.client->wait_for_status(
+      p.id, [](const PullOutStatus& s) { return s.state == ExecutionState::kWaitingApproval; }, kReplyTimeout);
   ASSERT_TRUE(executing);
   EXPECT_EQ(executing->current_path_idx, 0u);
   EXPECT_EQ(executing->segment_count, 3u);
-  drive(*client, id, *path);
+  drive(*p.client, p.id, *p.path);
 }
 
 TEST_F(MultiSegmentExecution, ReverseThenShiftWhenACarIsCloseAhead) {
-  start_service();
-  const Scenario scenario = load_test_scenario("car_close_ahead");
-  auto client = connect("int-multi-shift");
-  ASSERT_NE(client, nullptr);
-  const std::uint64_t id = client->send(scenario.request);
-  const auto path = client->wait_for_path(id, kReplyTimeout);
-  ASSERT_TRUE(path);
-  expect_found_path_invariants(*path);
-  ASSERT_EQ(path->partial_paths.size(), 2u) << "reverse, shift";
-  drive(*client, id, *path);
+  const Planned p = plan("car_close_ahead", "int-multi-shift");
+  ASSERT_TRUE(p.path);
+  ASSERT_EQ(p.path->partial_paths.size(), 2u) << "reverse, shift";
+  drive(*p.client, p.id, *p.path);
 }
 
 }  // namespace

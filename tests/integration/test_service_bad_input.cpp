@@ -109,8 +109,8 @@ void expect_served(const Client& client, std::uint64_t id) {
   ASSERT_TRUE(path) << client.vehicle_id() << ": no path for request " << id;
   expect_found_path_invariants(*path);
   const auto status = client.wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
-  EXPECT_TRUE(status) << client.vehicle_id() << ": no EXECUTING status for request " << id;
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
+  EXPECT_TRUE(status) << client.vehicle_id() << ": no WAITING_APPROVAL status for request " << id;
 }
 
 TEST_F(BadInput, MalformedRequestsAreRejectedNamingTheFieldWhileOthersAreServed) {

@@ -44,15 +44,19 @@ TEST_F(MapService, RouteRequestIsAnsweredAndABadRouteIsRejectedNamingTheField) {
     for (std::int64_t lane : point.lane_ids) on_route = on_route || lane == 102;
   }
   EXPECT_TRUE(on_route) << "the path never reaches route lanelet 102";
-  const auto executing = client->wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
-  EXPECT_TRUE(executing);
+  // Found: the service waits for the vehicle's approval to depart.
+  const auto waiting = client->wait_for_status(
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
+  EXPECT_TRUE(waiting);
 
-  // Lanelets 101 and 103 are not consecutive: rejected, the field named in the status and path.
+  // Another vehicle (the first one's path is latched until it departs): lanelets 101 and 103 are
+  // not consecutive, rejected with the field named.
+  auto other = connect("int-map-bad");
+  ASSERT_NE(other, nullptr);
   PullOutRequest bad = scenario.request;
   bad.route_lanelet_ids = {101, 103};
-  const std::uint64_t bad_id = client->send(bad);
-  const auto rejected = client->wait_for_status(
+  const std::uint64_t bad_id = other->send(bad);
+  const auto rejected = other->wait_for_status(
       bad_id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kRejected); }, kReplyTimeout);
   ASSERT_TRUE(rejected) << "no REJECTED status for the bad route";
   EXPECT_NE(rejected->error.find("route_lanelet_ids[1]"), std::string::npos) << rejected->error;
@@ -60,15 +64,15 @@ TEST_F(MapService, RouteRequestIsAnsweredAndABadRouteIsRejectedNamingTheField) {
 
   // An unknown lanelet id.
   bad.route_lanelet_ids = {101, 777};
-  const std::uint64_t unknown_id = client->send(bad);
-  const auto unknown = client->wait_for_status(
+  const std::uint64_t unknown_id = other->send(bad);
+  const auto unknown = other->wait_for_status(
       unknown_id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kRejected); }, kReplyTimeout);
   ASSERT_TRUE(unknown);
   EXPECT_NE(unknown->error.find("route_lanelet_ids[1]: unknown lanelet id 777"), std::string::npos) << unknown->error;
 
-  // The service keeps serving the good route.
-  const std::uint64_t again = client->send(scenario.request);
-  const auto path_again = client->wait_for_path(again, kReplyTimeout);
+  // The service keeps serving the good route, to that vehicle too.
+  const std::uint64_t again = other->send(scenario.request);
+  const auto path_again = other->wait_for_path(again, kReplyTimeout);
   ASSERT_TRUE(path_again);
   EXPECT_TRUE(path_again->found);
 }

@@ -51,7 +51,7 @@ TEST_F(PullOutFlow, StraightShoulderIsPlannedAndExecutedToCompletion) {
   EXPECT_EQ(path->planner_type, PlannerType::kShift);
 
   const auto executing = client->wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
   ASSERT_TRUE(executing) << "latest status: "
                          << (client->latest_status() ? static_cast<int>(client->latest_status()->state) : -1);
   EXPECT_EQ(executing->current_path_idx, 0u);
@@ -126,7 +126,7 @@ TEST_F(PullOutFlow, ClientStartedAfterTheReplyGetsTheLatestPath) {
     ASSERT_TRUE(path->found);
     segments = path->partial_paths.size();
     ASSERT_TRUE(first->wait_for_status(
-        id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout));
+        id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout));
   }  // the first client is gone: only the service's transient-local history has the reply now
 
   // The second client takes its QoS from the shipped profiles file (the first used the built-in
@@ -143,19 +143,17 @@ TEST_F(PullOutFlow, ClientStartedAfterTheReplyGetsTheLatestPath) {
   // A restarted client adopts the request the service last answered.
   EXPECT_EQ(second->current_request_id(), id);
   const auto status = second->wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
   ASSERT_TRUE(status);
   EXPECT_EQ(second->current_segment(), std::optional<std::uint32_t>(0u));
 }
 
-TEST_F(PullOutFlow, BoxedInGivesAStopPathAndNoPathWithReasons) {
-  start_service();
-  const Scenario scenario = load_test_scenario("boxed_in");
-  auto client = connect("int-boxed-in");
-  ASSERT_NE(client, nullptr);
-
-  const std::uint64_t id = client->send(scenario.request);
-  const auto path = client->wait_for_path(id, kReplyTimeout);
+// Sends the boxed_in scenario and checks the reply: a stop path (found = false, every velocity 0,
+// reasons) and NO_PATH with a stop reason and an evaluation table in which nothing succeeded.
+// `status` receives the NO_PATH status; `table` the table as text for failure messages.
+void expect_boxed_in_reply(Client& client, const Scenario& scenario, PullOutStatus& status, std::string& table) {
+  const std::uint64_t id = client.send(scenario.request);
+  const auto path = client.wait_for_path(id, kReplyTimeout);
   ASSERT_TRUE(path);
   EXPECT_FALSE(path->found);
   EXPECT_FALSE(path->reasons.empty());
@@ -167,25 +165,64 @@ TEST_F(PullOutFlow, BoxedInGivesAStopPathAndNoPathWithReasons) {
   }
   for (const auto& pair : path->pairs_terminal_velocity_and_accel) EXPECT_EQ(pair.velocity_mps, 0.0);
 
-  const auto status = client->wait_for_status(
+  const auto no_path = client.wait_for_status(
       id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kNoPath); }, kReplyTimeout);
-  ASSERT_TRUE(status) << "no NO_PATH status";
-  EXPECT_FALSE(status->stop_reason.empty());
-  EXPECT_EQ(client->current_segment(), std::nullopt);
-  // Every margin of the service's ladder was tried, each attempt recorded with its outcome.
-  ASSERT_FALSE(status->evaluation_table.empty());
-  std::set<double> margins;
-  std::ostringstream table;
-  for (const PlannerAttempt& row : status->evaluation_table) {
-    margins.insert(row.margin_m);
-    table << "\n  planner " << static_cast<int>(row.planner) << ", margin " << row.margin_m << " m, backward "
-          << row.backward_distance_m << " m: " << row.outcome;
+  ASSERT_TRUE(no_path) << "no NO_PATH status";
+  EXPECT_FALSE(no_path->stop_reason.empty());
+  EXPECT_EQ(client.current_segment(), std::nullopt);
+  ASSERT_FALSE(no_path->evaluation_table.empty());
+  std::ostringstream text;
+  for (const PlannerAttempt& row : no_path->evaluation_table) {
+    text << "\n  planner " << static_cast<int>(row.planner) << ", margin " << row.margin_m << " m, backward "
+         << row.backward_distance_m << " m: " << row.outcome;
     EXPECT_FALSE(row.outcome.empty());
     EXPECT_NE(row.outcome, "success");
   }
+  status = *no_path;
+  table = text.str();
+}
+
+TEST_F(PullOutFlow, BoxedInGivesAStopPathAndNoPathWithReasons) {
+  // The shipped config searches backward start poses (enable_back) and skips a start candidate
+  // closer than collision_check_margin_from_front_object to an object ahead, as Autoware does,
+  // the current pose included: here no candidate survives, and the table says why for each.
+  start_service();
+  const Scenario scenario = load_test_scenario("boxed_in");
+  auto client = connect("int-boxed-in");
+  ASSERT_NE(client, nullptr);
+  PullOutStatus status;
+  std::string table;
+  expect_boxed_in_reply(*client, scenario, status, table);
+  if (HasFatalFailure()) return;
+  bool current_pose_explained = false;
+  for (const PlannerAttempt& row : status.evaluation_table) {
+    current_pose_explained = current_pose_explained || row.backward_distance_m == 0.0;
+  }
+  EXPECT_TRUE(current_pose_explained) << "no row for the current pose:" << table;
+}
+
+TEST_F(PullOutFlow, BoxedInWithoutBackwardSearchTriesEveryMargin) {
+  // Only the current pose as start candidate: every margin of the ladder is tried, each attempt
+  // recorded with its outcome.
+  const std::string config = temp_.write_file("no_back.yaml",
+                                              "start_planner:\n"
+                                              "  enable_back: false\n"
+                                              "dds:\n"
+                                              "  profiles_file: " +
+                                                  loopback_profiles_path() + "\n");
+  start_service(config);
+  const Scenario scenario = load_scenario(scenario_path("boxed_in"), load_config(config));
+  auto client = connect("int-boxed-in-no-back");
+  ASSERT_NE(client, nullptr);
+  PullOutStatus status;
+  std::string table;
+  expect_boxed_in_reply(*client, scenario, status, table);
+  if (HasFatalFailure()) return;
+  std::set<double> margins;
+  for (const PlannerAttempt& row : status.evaluation_table) margins.insert(row.margin_m);
   const auto& ladder = scenario.parameters.collision_check_margins;
-  EXPECT_EQ(margins, std::set<double>(ladder.begin(), ladder.end())) << "evaluation table:" << table.str();
-  EXPECT_EQ(margins.size(), 4u);
+  EXPECT_EQ(margins, std::set<double>(ladder.begin(), ladder.end())) << "evaluation table:" << table;
+  EXPECT_EQ(margins.size(), 4u) << "evaluation table:" << table;
 }
 
 TEST_F(PullOutFlow, FiveThousandPointPathArrives) {
@@ -231,7 +268,7 @@ TEST_F(PullOutFlow, FiveThousandPointPathArrives) {
   EXPECT_LT(elapsed, kBound) << "took " << std::chrono::duration_cast<std::chrono::milliseconds>(elapsed).count()
                              << " ms";
   const auto status = client->wait_for_status(
-      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
   ASSERT_TRUE(status);
   EXPECT_EQ(status->segment_count, path->partial_paths.size());
 }
@@ -299,7 +336,7 @@ TEST_F(PullOutFlow, TwentyVehiclesAtOnceAreAllServed) {
   // And each vehicle's status is its own.
   for (int i = 0; i < kVehicles; ++i) {
     const auto status = clients[i]->wait_for_status(
-        ids[i], [](const PullOutStatus& s) { return is_state(s, ExecutionState::kExecuting); }, kReplyTimeout);
+        ids[i], [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
     EXPECT_TRUE(status) << clients[i]->vehicle_id();
   }
 }

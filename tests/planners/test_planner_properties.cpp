@@ -164,8 +164,12 @@ TEST_P(ScenarioExpectations, MatchTheFile) {
   const PlanningResult r = planner.plan(sc.request, Deadline());
   ASSERT_TRUE(sc.expect.found.has_value()) << "every bundled scenario states whether a path exists";
   EXPECT_EQ(r.path.found, *sc.expect.found) << r.stop_reason;
-  if (sc.expect.planner) EXPECT_EQ(to_string(r.path.planner_type), std::string(to_string(*sc.expect.planner)));
-  if (sc.expect.margin_m && r.path.found) EXPECT_DOUBLE_EQ(r.evaluation_table.back().margin_m, *sc.expect.margin_m);
+  if (sc.expect.planner) {
+    EXPECT_EQ(to_string(r.path.planner_type), std::string(to_string(*sc.expect.planner)));
+  }
+  if (sc.expect.margin_m && r.path.found) {
+    EXPECT_DOUBLE_EQ(r.evaluation_table.back().margin_m, *sc.expect.margin_m);
+  }
   if (!r.path.found) {
     EXPECT_FALSE(r.path.reasons.empty());
     for (const auto& p : r.path.partial_paths[0].points) EXPECT_DOUBLE_EQ(p.longitudinal_velocity_mps, 0.0);

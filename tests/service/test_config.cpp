@@ -250,9 +250,10 @@ TEST(Config, UnknownSectionAndNestedKeyAreNamed) {
 }
 
 TEST(Config, AutowareOnlyKeyGetsAClearMessage) {
-  const auto p = problems_of(std::string(kMinimal) + "start_planner: {skip_rear_vehicle_check: true}\n");
+  const auto p = problems_of(std::string(kMinimal) + "start_planner: {turn_signal_on_centerline_start: RIGHT}\n");
   ASSERT_EQ(p.size(), 1u) << dump(p);
-  EXPECT_NE(p[0].find("start_planner.skip_rear_vehicle_check: Autoware parameter not supported"), std::string::npos)
+  EXPECT_NE(p[0].find("start_planner.turn_signal_on_centerline_start: Autoware parameter not supported"),
+            std::string::npos)
       << dump(p);
 }
 
@@ -428,6 +429,52 @@ TEST(ConfigMap, MissingFileAndUnknownKeysAreNamed) {
   EXPECT_TRUE(any_starts_with(p, "map.origin: unknown key")) << dump(p);
   p = problems_of(std::string(kMinimal) + "map: {path: [1, 2]}\n");
   EXPECT_TRUE(any_starts_with(p, "map.path:")) << dump(p);
+}
+
+TEST(Config, SafetySectionsLoadWithAutowareNames) {
+  const Config d;
+  const Config shipped = load_config(kShippedConfig);
+  const StartPlannerParameters& s = shipped.start_planner;
+  EXPECT_DOUBLE_EQ(s.path_safety_check.safety_check_params.rss_params.rear_vehicle_reaction_time, 2.0);
+  EXPECT_DOUBLE_EQ(s.path_safety_check.ego_predicted_path.delay_until_departure, 1.0);
+  EXPECT_DOUBLE_EQ(s.path_safety_check.target_filtering.ignore_object_velocity_threshold, 0.25);
+  EXPECT_FALSE(s.path_safety_check.target_filtering.object_types_to_check.check_unknown);
+  EXPECT_DOUBLE_EQ(s.surround_moving_obstacle_check.search_radius, 10.0);
+  EXPECT_DOUBLE_EQ(s.stop_condition.maximum_jerk_for_stop, d.start_planner.stop_condition.maximum_jerk_for_stop);
+  EXPECT_DOUBLE_EQ(s.backward_path_update_duration, 3.0);
+  EXPECT_FALSE(s.skip_rear_vehicle_check);
+
+  ConfigFile file(std::string(kMinimal) +
+                  "start_planner:\n"
+                  "  skip_rear_vehicle_check: true\n"
+                  "  prepare_time_before_start: 1.5\n"
+                  "  path_safety_check:\n"
+                  "    safety_check_params:\n"
+                  "      rss_params: {rear_vehicle_reaction_time: 1.2, extended_polygon_policy: rectangle}\n"
+                  "  stop_condition: {maximum_deceleration_for_stop: 2.0}\n");
+  const Config c = load_config(file.path());
+  EXPECT_TRUE(c.start_planner.skip_rear_vehicle_check);
+  EXPECT_DOUBLE_EQ(c.start_planner.prepare_time_before_start, 1.5);
+  EXPECT_DOUBLE_EQ(c.start_planner.path_safety_check.safety_check_params.rss_params.rear_vehicle_reaction_time, 1.2);
+  EXPECT_EQ(c.start_planner.path_safety_check.safety_check_params.rss_params.extended_polygon_policy,
+            ExtendedPolygonPolicy::kRectangle);
+  EXPECT_DOUBLE_EQ(c.start_planner.stop_condition.maximum_deceleration_for_stop, 2.0);
+}
+
+TEST(Config, SafetyValuesAreRangeChecked) {
+  const auto p = problems_of(std::string(kMinimal) +
+                             "start_planner:\n"
+                             "  path_safety_check:\n"
+                             "    ego_predicted_path: {time_resolution: 0.0}\n"
+                             "    safety_check_params: {rss_params: {rear_vehicle_deceleration: 1.0}}\n"
+                             "  stop_condition: {maximum_jerk_for_stop: -1.0, jerk: 1}\n");
+  EXPECT_TRUE(any_starts_with(p, "start_planner.path_safety_check.ego_predicted_path.time_resolution: must be in"))
+      << dump(p);
+  EXPECT_TRUE(any_starts_with(
+      p, "start_planner.path_safety_check.safety_check_params.rss_params.rear_vehicle_deceleration: must be in"))
+      << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.stop_condition.maximum_jerk_for_stop: must be in")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.stop_condition.jerk: unknown key")) << dump(p);
 }
 
 }  // namespace

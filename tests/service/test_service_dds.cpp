@@ -325,7 +325,7 @@ TEST_F(ServiceDds, FoundPathAndStatus) {
   ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "found-1", 11)));
   const auto status = client_->final_status("found-1", 11);
   ASSERT_TRUE(status.has_value());
-  EXPECT_EQ(status->state, ExecutionState::kExecuting) << status->stop_reason << status->error;
+  EXPECT_EQ(status->state, ExecutionState::kWaitingApproval) << status->stop_reason << status->error;
   EXPECT_EQ(status->current_path_idx, 0u);
   EXPECT_EQ(status->planner_type, PlannerType::kShift);
   EXPECT_FALSE(status->evaluation_table.empty());
@@ -348,7 +348,7 @@ TEST_F(ServiceDds, ProgressAdvancesToCompletion) {
   ASSERT_TRUE(path->found);
   const auto executing = client_->final_status("drive-1", 21);
   ASSERT_TRUE(executing.has_value());
-  ASSERT_EQ(executing->state, ExecutionState::kExecuting);
+  ASSERT_EQ(executing->state, ExecutionState::kWaitingApproval);
 
   std::int64_t stamp = 1'000'000'000;
   const auto send_progress = [&](std::uint64_t request_id, const Pose2& pose, double v) {
@@ -432,7 +432,7 @@ TEST_F(ServiceDds, MalformedRequestIsRejectedNamingTheField) {
   ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "bad-1", 42)));
   const auto good = client_->final_status("bad-1", 42);
   ASSERT_TRUE(good.has_value());
-  EXPECT_EQ(good->state, ExecutionState::kExecuting);
+  EXPECT_EQ(good->state, ExecutionState::kWaitingApproval);
 }
 
 TEST_F(ServiceDds, UndecodableSampleIsDroppedAndTheServiceGoesOn) {
@@ -442,7 +442,7 @@ TEST_F(ServiceDds, UndecodableSampleIsDroppedAndTheServiceGoesOn) {
   ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "garbage-1", 45)));
   const auto status = client_->final_status("garbage-1", 45);
   ASSERT_TRUE(status.has_value());
-  EXPECT_EQ(status->state, ExecutionState::kExecuting);
+  EXPECT_EQ(status->state, ExecutionState::kWaitingApproval);
 }
 
 TEST_F(ServiceDds, CoreValidationRejectsAnInconsistentRequest) {
@@ -466,7 +466,7 @@ TEST_F(ServiceDds, ManyVehiclesAtOnce) {
     const std::string id = "fleet-" + std::to_string(i);
     const auto status = client_->final_status(id, 100 + i);
     ASSERT_TRUE(status.has_value()) << id;
-    EXPECT_EQ(status->state, i % 4 == 3 ? ExecutionState::kNoPath : ExecutionState::kExecuting) << id;
+    EXPECT_EQ(status->state, i % 4 == 3 ? ExecutionState::kNoPath : ExecutionState::kWaitingApproval) << id;
     const auto path = client_->path_of(id, 100 + i);
     ASSERT_TRUE(path.has_value()) << id;
     EXPECT_EQ(path->found, i % 4 != 3) << id;
@@ -481,7 +481,7 @@ TEST_F(ServiceDds, NewerRequestReplacesTheOlderOne) {
   }
   const auto last = client_->final_status("replace-1", 63);
   ASSERT_TRUE(last.has_value());
-  EXPECT_EQ(last->state, ExecutionState::kExecuting);
+  EXPECT_EQ(last->state, ExecutionState::kWaitingApproval);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   std::uint64_t latest_seen = 0;
   for (const auto& s : client_->statuses->samples()) {
@@ -515,7 +515,7 @@ TEST_F(ServiceDds, LargeRequestArrivesAndIsPlanned) {
   ASSERT_TRUE(client_->send(r));
   const auto status = client_->final_status("large-1", 71);
   ASSERT_TRUE(status.has_value());
-  EXPECT_EQ(status->state, ExecutionState::kExecuting) << status->error << status->stop_reason;
+  EXPECT_EQ(status->state, ExecutionState::kWaitingApproval) << status->error << status->stop_reason;
   const double round_trip_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   EXPECT_LT(round_trip_ms - status->planning_time_ms, 1000.0)
       << "transport took " << round_trip_ms - status->planning_time_ms << " ms";

@@ -41,6 +41,10 @@ void ExecutionTracker::clear() {
   stopped_since_ns_.reset();
 }
 
+void ExecutionTracker::adopt(std::uint64_t request_id) {
+  if (path_) path_->request_id = request_id;
+}
+
 ExecutionTracker::Update ExecutionTracker::on_progress(const ExecutionProgress& progress) {
   Update u{false, current_path_idx_, completed_};
   if (!path_ || progress.request_id != path_->request_id || completed_ || path_->partial_paths.empty()) return u;

@@ -184,6 +184,44 @@ std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p)
   }
   c.in_range("clothoid_max_steer_angle_rate_deg_per_sec", p.clothoid_max_steer_angle_rate_deg_per_sec, 0.1, 1000.0);
   c.finite("clothoid_collision_check_distance_from_end", p.clothoid_collision_check_distance_from_end);
+
+  // Dynamic safety. Time steps are bounded below so that a horizon has at most a few thousand samples.
+  const std::string ego = "path_safety_check.ego_predicted_path.";
+  const EgoPredictedPathParameters& e = p.path_safety_check.ego_predicted_path;
+  c.in_range(ego + "min_velocity", e.min_velocity, 0.0, 50.0);
+  c.in_range(ego + "min_acceleration", e.min_acceleration, -10.0, 10.0);
+  c.in_range(ego + "time_horizon_for_front_object", e.time_horizon_for_front_object, 0.0, 60.0);
+  c.in_range(ego + "time_horizon_for_rear_object", e.time_horizon_for_rear_object, 0.0, 60.0);
+  c.in_range(ego + "time_resolution", e.time_resolution, 0.01, 10.0);
+  c.in_range(ego + "delay_until_departure", e.delay_until_departure, 0.0, 60.0);
+  const std::string tf = "path_safety_check.target_filtering.";
+  const TargetFilteringParameters& f = p.path_safety_check.target_filtering;
+  c.in_range(tf + "safety_check_time_horizon", f.safety_check_time_horizon, 0.0, 60.0);
+  c.in_range(tf + "safety_check_time_resolution", f.safety_check_time_resolution, 0.01, 10.0);
+  c.in_range(tf + "object_check_forward_distance", f.object_check_forward_distance, 0.0, 1000.0);
+  c.in_range(tf + "object_check_backward_distance", f.object_check_backward_distance, 0.0, 1000.0);
+  c.non_negative(tf + "ignore_object_velocity_threshold", f.ignore_object_velocity_threshold);
+  const std::string sc = "path_safety_check.safety_check_params.";
+  const SafetyCheckParams& s = p.path_safety_check.safety_check_params;
+  c.in_range(sc + "hysteresis_factor_expand_rate", s.hysteresis_factor_expand_rate, 1.0, 10.0);
+  c.in_range(sc + "collision_check_yaw_diff_threshold", s.collision_check_yaw_diff_threshold, 0.0, 3.15);
+  const std::string rss = sc + "rss_params.";
+  c.in_range(rss + "rear_vehicle_reaction_time", s.rss_params.rear_vehicle_reaction_time, 0.0, 10.0);
+  c.in_range(rss + "rear_vehicle_safety_time_margin", s.rss_params.rear_vehicle_safety_time_margin, 0.0, 10.0);
+  c.in_range(rss + "lateral_distance_max_threshold", s.rss_params.lateral_distance_max_threshold, 0.0, 10.0);
+  c.in_range(rss + "longitudinal_distance_min_threshold", s.rss_params.longitudinal_distance_min_threshold, 0.0, 100.0);
+  c.in_range(rss + "longitudinal_velocity_delta_time", s.rss_params.longitudinal_velocity_delta_time, 0.0, 10.0);
+  c.in_range(rss + "front_vehicle_deceleration", s.rss_params.front_vehicle_deceleration, -20.0, -0.01);
+  c.in_range(rss + "rear_vehicle_deceleration", s.rss_params.rear_vehicle_deceleration, -20.0, -0.01);
+  c.non_negative("surround_moving_obstacle_check.search_radius", p.surround_moving_obstacle_check.search_radius);
+  c.non_negative("surround_moving_obstacle_check.th_moving_obstacle_velocity",
+                 p.surround_moving_obstacle_check.th_moving_obstacle_velocity);
+  c.in_range("stop_condition.maximum_deceleration_for_stop", p.stop_condition.maximum_deceleration_for_stop, 0.01,
+             20.0);
+  c.in_range("stop_condition.maximum_jerk_for_stop", p.stop_condition.maximum_jerk_for_stop, 0.01, 50.0);
+  c.in_range("extra_width_margin_for_rear_obstacle", p.extra_width_margin_for_rear_obstacle, 0.0, 10.0);
+  c.in_range("prepare_time_before_start", p.prepare_time_before_start, 0.0, 60.0);
+  c.in_range("backward_path_update_duration", p.backward_path_update_duration, 0.0, 600.0);
   return issues;
 }
 

@@ -32,19 +32,21 @@ StartCandidateSearch search_start_candidates(const PlanningContext& ctx, const P
   const auto proj = lanes.centerline.project(to_vec(ego));
   const double allowed = std::clamp(proj.s - ctx.vehicle.base_to_rear_m(), 0.0, p.max_back_distance);
   const double last_margin = p.collision_check_margins.back();
-  for (double back = 0.0; back <= allowed + 1e-9; back += p.backward_search_resolution) {
-    const Pose2 pose = back == 0.0 ? ego : backed_pose(lanes, proj.s, proj.lateral, back);
+  // The current pose is always candidate 0, whatever is ahead (Autoware MAIN also puts the ego
+  // pose first); the checks below pick the poses worth reversing to.
+  out.candidates.push_back({ego, 0.0});
+  for (double back = p.backward_search_resolution; back <= allowed + 1e-9; back += p.backward_search_resolution) {
+    const Pose2 pose = backed_pose(lanes, proj.s, proj.lateral, back);
     const std::string at = "start candidate";
-    if (back > 0.0) {
-      const auto hit = ctx.objects.clearance(pose, last_margin);
-      if (hit.distance < last_margin) {
-        out.skipped.push_back({back, at + " within " + format_fixed(last_margin, 2) + " m of object " +
-                                         std::to_string(hit.obstacle_id) + ": backward search ends"});
-        break;
-      }
+    const auto hit = ctx.objects.clearance(pose, last_margin);
+    if (hit.distance < last_margin) {
+      out.skipped.push_back({back, at + " within " + format_fixed(last_margin, 2) + " m of object " +
+                                       std::to_string(hit.obstacle_id) + ": backward search ends"});
+      break;
     }
     const auto front = ctx.objects.clearance_ahead(pose, p.collision_check_margin_from_front_object);
-    if (front.distance < p.collision_check_margin_from_front_object) {
+    // 1 um below the margin: a candidate exactly at it (up to rounding) counts as clear.
+    if (front.distance < p.collision_check_margin_from_front_object - 1e-6) {
       out.skipped.push_back({back, at + " skipped: " + format_fixed(front.distance, 2) + " m from object " +
                                        std::to_string(front.obstacle_id) +
                                        " ahead (collision_check_margin_from_front_object " +

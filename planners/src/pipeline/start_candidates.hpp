@@ -22,13 +22,13 @@ struct StartCandidateSearch {
   std::vector<Skipped> skipped;  // candidates skipped, and the one that ended the search
 };
 
-// With enable_back: poses every backward_search_resolution behind the vehicle on the line
-// through it parallel to the pull-out lanes' centerline, up to max_back_distance (and no further
-// than keeps the rear inside the pull-out lanes). A candidate within
-// collision_check_margin_from_front_object of a static obstacle ahead of it, or closer than
-// ignore_distance_from_lane_end to the lanes' end, is skipped; the first one within the smallest
-// collision margin of any obstacle ends the search (the vehicle cannot reverse through it).
-// Candidate 0 is the current pose itself. Without enable_back: only the current pose.
+// Candidate 0 is the current pose itself, always. With enable_back, then: poses every
+// backward_search_resolution behind the vehicle on the line through it parallel to the pull-out
+// lanes' centerline, up to max_back_distance (and no further than keeps the rear inside the
+// pull-out lanes). A backward candidate within collision_check_margin_from_front_object of a
+// static obstacle ahead of it, or closer than ignore_distance_from_lane_end to the lanes' end, is
+// skipped; the first one within the smallest collision margin of any obstacle ends the search
+// (the vehicle cannot reverse through it).
 StartCandidateSearch search_start_candidates(const PlanningContext& context, const Pose2& ego);
 
 // The reverse segment from `ego` back to `candidate` along the pull-out lanes: points every

@@ -51,7 +51,7 @@ PathCandidate make_turn_candidate(
 
   auto shared_turns = std::make_shared<const TwoTurnPath>(turns);
   const double interval = options.output_interval;
-  candidate.build = [&ctx, shared_turns, interval, velocity, segment]() {
+  candidate.build = [&ctx, shared_turns, interval, velocity = std::move(velocity), segment = std::move(segment)]() {
     std::vector<std::size_t> junctions;
     const std::vector<Pose2> pts = shared_turns->path.sample(interval, junctions);
     const std::vector<double> d = cumulative_distance(pts);

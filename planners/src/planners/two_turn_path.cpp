@@ -31,9 +31,14 @@ std::vector<CurvaturePiece> two_turns(double d1, double d2, const TwoTurnSpec& s
 
 Evaluation evaluate(const Pose2& start, double d1, double psi_target, const Polyline& center, const TwoTurnSpec& spec) {
   const double d2 = normalize_angle(psi_target - start.yaw - d1);
+  // Called tens of times per solve: the pieces go into a reused buffer, not a new vector.
+  thread_local std::vector<CurvaturePiece> pieces;
+  pieces.clear();
+  append_turn(pieces, d1, spec.kappa, spec.sharpness);
+  if (spec.straight > 1e-9) pieces.push_back({spec.straight, 0.0, 0.0});
+  append_turn(pieces, d2, spec.kappa, spec.sharpness);
   Pose2 p = start;
-  for (const CurvaturePiece& piece : two_turns(d1, d2, spec, nullptr))
-    p = CurvaturePath::advance(p, piece, piece.length);
+  for (const CurvaturePiece& piece : pieces) p = CurvaturePath::advance(p, piece, piece.length);
   const auto proj = center.project(to_vec(p));
   return {proj.lateral, proj.s, p};
 }

@@ -34,18 +34,13 @@ std::string join_lines(const std::string& file, const std::vector<std::string>& 
 // Autoware start_planner parameters that this version does not implement: a clearer message
 // than "unknown key" for users who bring Autoware's file along.
 const char* start_planner_hint(const std::string& key) {
-  static constexpr std::array<std::string_view, 11> kAutowareOnly{
-      "skip_rear_vehicle_check",
-      "extra_width_margin_for_rear_obstacle",
+  static constexpr std::array<std::string_view, 6> kAutowareOnly{
       "th_distance_to_middle_of_the_road",
       "maximum_longitudinal_deviation",
       "minimum_shift_length",
-      "backward_path_update_duration",
-      "prepare_time_before_start",
       "turn_signal_on_centerline_start",
       "freespace_planner",
-      "path_safety_check",
-      "surround_moving_obstacle_check",
+      "debug",
   };
   if (std::find(kAutowareOnly.begin(), kAutowareOnly.end(), key) != kAutowareOnly.end()) {
     return "Autoware parameter not supported in this version";
@@ -118,7 +113,8 @@ void read_search_policy(MapReader& r, SearchPolicy& out) {
   }
 }
 
-void read_object_types(MapReader& parent, const std::string& key, ObjectTypesToCheck& out) {
+template <typename Types>
+void read_object_types(MapReader& parent, const std::string& key, Types& out) {
   MapReader r(parent.get(key), parent.key_path(key), parent.problems());
   if (!r.valid()) return;
   r.read("check_car", out.check_car);
@@ -130,6 +126,124 @@ void read_object_types(MapReader& parent, const std::string& key, ObjectTypesToC
   r.read("check_pedestrian", out.check_pedestrian);
   r.read("check_unknown", out.check_unknown);
   r.finish();
+}
+
+// Autoware safety-check keys that are accepted but have no effect here (debug output, or lanes
+// this version does not model).
+const char* safety_hint(const std::string& key) {
+  static constexpr std::array<std::string_view, 6> kIgnored{
+      "check_right_side_lane", "check_left_side_lane", "check_other_lane",
+      "include_opposite_lane", "invert_opposite_lane", "use_predicted_path_outside_lanelet",
+  };
+  if (std::find(kIgnored.begin(), kIgnored.end(), key) != kIgnored.end()) {
+    return "Autoware parameter not supported in this version";
+  }
+  return nullptr;
+}
+
+void read_path_safety_check(MapReader& parent, PathSafetyCheckParameters& out) {
+  MapReader r(parent.get("path_safety_check"), parent.key_path("path_safety_check"), parent.problems());
+  if (!r.valid()) return;
+  {
+    MapReader e(r.get("ego_predicted_path"), r.key_path("ego_predicted_path"), r.problems());
+    if (e.valid()) {
+      EgoPredictedPathParameters& p = out.ego_predicted_path;
+      e.read("min_velocity", p.min_velocity);
+      e.read("min_acceleration", p.min_acceleration);
+      e.read("time_horizon_for_front_object", p.time_horizon_for_front_object);
+      e.read("time_horizon_for_rear_object", p.time_horizon_for_rear_object);
+      e.read("time_resolution", p.time_resolution);
+      e.read("delay_until_departure", p.delay_until_departure);
+      e.finish();
+    }
+  }
+  {
+    MapReader t(r.get("target_filtering"), r.key_path("target_filtering"), r.problems());
+    if (t.valid()) {
+      TargetFilteringParameters& p = out.target_filtering;
+      t.read("safety_check_time_horizon", p.safety_check_time_horizon);
+      t.read("safety_check_time_resolution", p.safety_check_time_resolution);
+      t.read("object_check_forward_distance", p.object_check_forward_distance);
+      t.read("object_check_backward_distance", p.object_check_backward_distance);
+      t.read("ignore_object_velocity_threshold", p.ignore_object_velocity_threshold);
+      read_object_types(t, "object_types_to_check", p.object_types_to_check);
+      MapReader lanes(t.get("object_lane_configuration"), t.key_path("object_lane_configuration"), t.problems());
+      if (lanes.valid()) {
+        lanes.read("check_current_lane", p.check_current_lane);
+        lanes.read("check_shoulder_lane", p.check_shoulder_lane);
+        lanes.finish(&safety_hint);
+      }
+      t.read("use_all_predicted_path", p.use_all_predicted_path);
+      bool check_all = true;  // Autoware's older name of use_all_predicted_path
+      if (t.read("check_all_predicted_path", check_all))
+        p.use_all_predicted_path = p.use_all_predicted_path && check_all;
+      t.finish(&safety_hint);
+    }
+  }
+  {
+    MapReader s(r.get("safety_check_params"), r.key_path("safety_check_params"), r.problems());
+    if (s.valid()) {
+      SafetyCheckParams& p = out.safety_check_params;
+      s.read("enable_safety_check", p.enable_safety_check);
+      s.read("hysteresis_factor_expand_rate", p.hysteresis_factor_expand_rate);
+      s.read("collision_check_yaw_diff_threshold", p.collision_check_yaw_diff_threshold);
+      bool ignored_flag = false;
+      double ignored_length = 0.0;
+      s.read("publish_debug_marker", ignored_flag);    // no markers here
+      s.read("backward_path_length", ignored_length);  // loaded but unused by Autoware too
+      s.read("forward_path_length", ignored_length);
+      MapReader rss(s.get("rss_params"), s.key_path("rss_params"), s.problems());
+      if (rss.valid()) {
+        RssParameters& q = p.rss_params;
+        rss.read("rear_vehicle_reaction_time", q.rear_vehicle_reaction_time);
+        rss.read("rear_vehicle_safety_time_margin", q.rear_vehicle_safety_time_margin);
+        rss.read("lateral_distance_max_threshold", q.lateral_distance_max_threshold);
+        rss.read("longitudinal_distance_min_threshold", q.longitudinal_distance_min_threshold);
+        rss.read("longitudinal_velocity_delta_time", q.longitudinal_velocity_delta_time);
+        rss.read("front_vehicle_deceleration", q.front_vehicle_deceleration);
+        rss.read("rear_vehicle_deceleration", q.rear_vehicle_deceleration);
+        std::string policy;
+        if (rss.read("extended_polygon_policy", policy)) {
+          if (policy == "along_path") {
+            q.extended_polygon_policy = ExtendedPolygonPolicy::kAlongPath;
+          } else if (policy == "rectangle") {
+            q.extended_polygon_policy = ExtendedPolygonPolicy::kRectangle;
+          } else {
+            rss.problems().push_back(rss.key_path("extended_polygon_policy") +
+                                     ": expected along_path or rectangle, got '" + policy + "'");
+          }
+        }
+        rss.finish();
+      }
+      s.finish();
+    }
+  }
+  r.finish();
+}
+
+void read_safety_sections(MapReader& r, StartPlannerParameters& p) {
+  read_path_safety_check(r, p.path_safety_check);
+  {
+    MapReader s(r.get("surround_moving_obstacle_check"), r.key_path("surround_moving_obstacle_check"), r.problems());
+    if (s.valid()) {
+      s.read("search_radius", p.surround_moving_obstacle_check.search_radius);
+      s.read("th_moving_obstacle_velocity", p.surround_moving_obstacle_check.th_moving_obstacle_velocity);
+      read_object_types(s, "object_types_to_check", p.surround_moving_obstacle_check.object_types_to_check);
+      s.finish();
+    }
+  }
+  {
+    MapReader s(r.get("stop_condition"), r.key_path("stop_condition"), r.problems());
+    if (s.valid()) {
+      s.read("maximum_deceleration_for_stop", p.stop_condition.maximum_deceleration_for_stop);
+      s.read("maximum_jerk_for_stop", p.stop_condition.maximum_jerk_for_stop);
+      s.finish();
+    }
+  }
+  r.read("skip_rear_vehicle_check", p.skip_rear_vehicle_check);
+  r.read("extra_width_margin_for_rear_obstacle", p.extra_width_margin_for_rear_obstacle);
+  r.read("prepare_time_before_start", p.prepare_time_before_start);
+  r.read("backward_path_update_duration", p.backward_path_update_duration);
 }
 
 void apply_limits(MapReader& parent, RequestLimits& out) {
@@ -338,6 +452,7 @@ void apply_start_planner_parameters(const YAML::Node& node, const std::string& p
   r.read("clothoid_max_steer_angle_rate_deg_per_sec", p.clothoid_max_steer_angle_rate_deg_per_sec);
   r.read("clothoid_collision_check_distance_from_end", p.clothoid_collision_check_distance_from_end);
   r.read("check_clothoid_path_lane_departure", p.check_clothoid_path_lane_departure);
+  read_safety_sections(r, p);
   r.finish(&start_planner_hint);
 }
 

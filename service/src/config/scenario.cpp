@@ -111,6 +111,46 @@ Lane read_lane(const YAML::Node& node, const std::string& path, Problems& proble
   return lane;
 }
 
+template <typename Item, typename ReadItem>
+std::vector<Item> read_list(MapReader& r, const std::string& key, ReadItem read_item) {
+  std::vector<Item> items;
+  const YAML::Node n = r.get(key);
+  if (!n.IsDefined() || n.IsNull()) return items;
+  const std::string path = r.key_path(key);
+  if (!n.IsSequence()) {
+    r.problems().push_back(path + ": expected a list" + yaml_fields::where(n));
+    return items;
+  }
+  for (std::size_t i = 0; i < n.size(); ++i) items.push_back(read_item(n[i], yaml_fields::indexed(path, i), i));
+  return items;
+}
+
+// {time_step, confidence, points: [[x, y], ...]}: poses every time_step seconds from now; each
+// pose heads towards the next point (the last keeps the previous heading).
+PredictedPath read_predicted_path(const YAML::Node& node, const std::string& path, Problems& problems) {
+  PredictedPath out;
+  MapReader r(node, path, problems);
+  if (!r.valid()) return out;
+  if (r.read("time_step", out.time_step_s) && !(out.time_step_s > 0.0)) {
+    problems.push_back(r.key_path("time_step") + ": must be > 0");
+  }
+  if (r.read("confidence", out.confidence) && !(out.confidence >= 0.0 && out.confidence <= 1.0)) {
+    problems.push_back(r.key_path("confidence") + ": must be in [0, 1]");
+  }
+  const std::vector<Point2> points = read_points(r, "points", 1);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    Pose2 pose{points[i].x, points[i].y, 0.0};
+    if (i + 1 < points.size()) {
+      pose.yaw = std::atan2(points[i + 1].y - points[i].y, points[i + 1].x - points[i].x);
+    } else if (i > 0) {
+      pose.yaw = out.poses.back().yaw;
+    }
+    out.poses.push_back(pose);
+  }
+  r.finish();
+  return out;
+}
+
 Object read_object(const YAML::Node& node, const std::string& path, std::size_t index, Problems& problems) {
   Object object;
   object.id = static_cast<std::int64_t>(index);  // default: the position in the list
@@ -137,26 +177,19 @@ Object read_object(const YAML::Node& node, const std::string& path, std::size_t 
     problems.push_back(r.key_path("width") + ": must be > 0");
   }
   r.read("velocity", object.velocity_mps);
+  object.predicted_paths =
+      read_list<PredictedPath>(r, "predicted_paths", [&](const YAML::Node& n, const std::string& p, std::size_t) {
+        PredictedPath path = read_predicted_path(n, p, problems);
+        // A single point has no heading of its own: the object's.
+        if (path.poses.size() == 1) path.poses[0].yaw = object.pose.yaw;
+        return path;
+      });
   object.polygon = read_points(r, "polygon", 0);
   if (r.has("polygon") && object.polygon.size() < 3) {
     problems.push_back(r.key_path("polygon") + ": needs at least 3 points when given");
   }
   r.finish();
   return object;
-}
-
-template <typename Item, typename ReadItem>
-std::vector<Item> read_list(MapReader& r, const std::string& key, ReadItem read_item) {
-  std::vector<Item> items;
-  const YAML::Node n = r.get(key);
-  if (!n.IsDefined() || n.IsNull()) return items;
-  const std::string path = r.key_path(key);
-  if (!n.IsSequence()) {
-    r.problems().push_back(path + ": expected a list" + yaml_fields::where(n));
-    return items;
-  }
-  for (std::size_t i = 0; i < n.size(); ++i) items.push_back(read_item(n[i], yaml_fields::indexed(path, i), i));
-  return items;
 }
 
 void read_expectation(MapReader& parent, ScenarioExpectation& out) {
@@ -175,6 +208,8 @@ void read_expectation(MapReader& parent, ScenarioExpectation& out) {
   }
   double margin = 0.0;
   if (r.read("margin", margin)) out.margin_m = margin;
+  bool safe = true;
+  if (r.read("safe", safe)) out.safe = safe;
   r.finish();
 }
 

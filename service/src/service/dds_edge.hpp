@@ -16,6 +16,7 @@
 #include <string>
 
 #include "pullout/config/config.hpp"
+#include "pullout/idl/topics.hpp"
 #include "service/outbox.hpp"
 
 namespace eprosima::fastdds::dds {
@@ -34,15 +35,14 @@ class DdsSetupError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-inline constexpr const char* kRequestTopic = "pullout/request";
-inline constexpr const char* kPathTopic = "pullout/path";
-inline constexpr const char* kStatusTopic = "pullout/status";
-inline constexpr const char* kProgressTopic = "pullout/progress";
-
-inline constexpr const char* kRequestReaderProfile = "pullout_request_reader";
-inline constexpr const char* kProgressReaderProfile = "pullout_progress_reader";
-inline constexpr const char* kPathWriterProfile = "pullout_path_writer";
-inline constexpr const char* kStatusWriterProfile = "pullout_status_writer";
+using idl::kPathTopic;
+using idl::kPathWriterProfile;
+using idl::kProgressReaderProfile;
+using idl::kProgressTopic;
+using idl::kRequestReaderProfile;
+using idl::kRequestTopic;
+using idl::kStatusTopic;
+using idl::kStatusWriterProfile;
 
 class DdsEdge final : public Outbox {
  public:

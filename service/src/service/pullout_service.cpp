@@ -45,7 +45,7 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
     : config_(config),
       dds_(config.dds),
       planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
-      registry_(config.start_planner, dds_) {
+      registry_(config.vehicle, config.start_planner, dds_) {
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
 }
 
@@ -154,9 +154,10 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
     spdlog::info("vehicle '{}' request {}: accepted (route of {} lanelets, {} objects)", request.vehicle_id,
                  request.request_id, request.route_lanelet_ids.size(), request.objects.size());
   }
-  PlanningJob job = registry_.accept(std::move(request));
-  const std::string vehicle = job.request.vehicle_id;
-  if (queue_->push(std::move(job))) {
+  std::optional<PlanningJob> job = registry_.accept(std::move(request));
+  if (!job) return;  // objects of a latched path updated
+  const std::string vehicle = job->request.vehicle_id;
+  if (queue_->push(std::move(*job))) {
     spdlog::debug("vehicle '{}': a waiting request was replaced by a newer one", vehicle);
   }
 }

@@ -130,7 +130,7 @@ class PULLOUT_CLIENT_EXPORT Client {
   // path).
   std::optional<std::uint32_t> current_segment() const;
 
-  // Blocks until the request writer and the path and status readers are each matched with a
+  // Blocks until the request and progress writers and the path and status readers are each matched with a
   // service endpoint, or the timeout expires. Returns whether they are. Discovery on loopback
   // usually takes tens of milliseconds but can take a few seconds (lost announcements are repeated
   // periodically): allow several seconds.

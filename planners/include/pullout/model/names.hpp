@@ -35,13 +35,15 @@ inline constexpr std::array<std::pair<PlannerType, const char*>, 6> kPlannerName
     {PlannerType::kStop, "stop"},
     {PlannerType::kFreespace, "freespace"},
 }};
-inline constexpr std::array<std::pair<ExecutionState, const char*>, 6> kStateNames{{
+inline constexpr std::array<std::pair<ExecutionState, const char*>, 8> kStateNames{{
     {ExecutionState::kIdle, "idle"},
     {ExecutionState::kPlanning, "planning"},
     {ExecutionState::kRejected, "rejected"},
     {ExecutionState::kNoPath, "no_path"},
     {ExecutionState::kExecuting, "executing"},
     {ExecutionState::kCompleted, "completed"},
+    {ExecutionState::kWaitingApproval, "waiting_approval"},
+    {ExecutionState::kWaitingSafety, "waiting_safety"},
 }};
 inline constexpr std::array<std::pair<ObjectClass, const char*>, 8> kClassNames{{
     {ObjectClass::kUnknown, "unknown"},

@@ -162,9 +162,19 @@ enum class ExecutionState : std::uint8_t {
   kPlanning = 1,   // request accepted, search running
   kRejected = 2,   // request invalid: see `error`
   kNoPath = 3,     // no path: a stop path was published, see `stop_reason`
-  kExecuting = 4,  // a path was found and is being followed (current_path_idx)
+  kExecuting = 4,  // approved and safe: the vehicle may drive the path (current_path_idx)
   kCompleted = 5,  // the vehicle passed the end pose of the last segment
+  // A path was found (published with found = true) but the vehicle must stand still:
+  kWaitingApproval = 6,  // until ExecutionProgress::approved is true
+  kWaitingSafety = 7,    // until safe (see `stop_reason`): before departure, or after a stop was
+                         // inserted into the published path because traffic became unsafe
 };
+
+// A found path exists for the request (waiting, executing or completed).
+inline bool has_path(ExecutionState s) {
+  return s == ExecutionState::kWaitingApproval || s == ExecutionState::kWaitingSafety ||
+         s == ExecutionState::kExecuting || s == ExecutionState::kCompleted;
+}
 
 struct PullOutStatus {
   std::string vehicle_id;
@@ -175,9 +185,17 @@ struct PullOutStatus {
   std::uint32_t segment_count{0};
   PlannerType planner_type{PlannerType::kNone};
   std::vector<PlannerAttempt> evaluation_table;
-  std::string stop_reason;
-  std::string error;  // kRejected: "<field>: <problem>" lines
+  std::string stop_reason;  // kNoPath, kWaitingApproval, kWaitingSafety: why the vehicle must stand
+  std::string error;        // kRejected: "<field>: <problem>" lines
   double planning_time_ms{0.0};
+  // Dynamic safety of the path at the last progress sample.
+  bool safe{true};
+  std::int64_t unsafe_object_id{0};  // the object that made it unsafe (safe == false)
+  bool departed{false};              // the vehicle has been released (kExecuting) on this path
+  // The turn signal the vehicle shows for this path, and the time (progress-sample clock, ns) from
+  // which it is on; departure waits prepare_time_before_start after it. 0 = not on yet.
+  TurnSignal turn_signal{TurnSignal::kNone};
+  std::int64_t turn_signal_start_ns{0};
 };
 
 // A problem with a request: the field (e.g. "lanes[2].left_bound[5].x", "ego_pose.orientation")

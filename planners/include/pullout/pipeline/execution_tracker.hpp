@@ -25,6 +25,9 @@ class ExecutionTracker {
   void start(const PullOutPath& path);
   // Forgets the path (no path, rejected request).
   void clear();
+  // Keeps following the same path, with its segment index and stop timer, under another request
+  // id (a re-sent request of the vehicle while the path is latched).
+  void adopt(std::uint64_t request_id);
 
   struct Update {
     bool changed{false};  // current_path_idx or completion changed with this sample

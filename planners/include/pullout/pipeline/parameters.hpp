@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pullout/model/types.hpp"
+#include "pullout/safety/safety_parameters.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace pullout {
@@ -84,6 +85,14 @@ struct StartPlannerParameters {
   double clothoid_max_steer_angle_rate_deg_per_sec{10.0};              // [deg/s]
   double clothoid_collision_check_distance_from_end{0.0};              // [m]
   bool check_clothoid_path_lane_departure{true};
+  // --- dynamic safety, approval, re-planning (see safety/safety_parameters.hpp) ---
+  PathSafetyCheckParameters path_safety_check;
+  SurroundMovingObstacleCheckParameters surround_moving_obstacle_check;
+  StopConditionParameters stop_condition;
+  bool skip_rear_vehicle_check{false};               // true: never bypass the check for a blocked rear vehicle
+  double extra_width_margin_for_rear_obstacle{0.5};  // [m] added to the rear vehicle's width
+  double prepare_time_before_start{0.0};             // [s] turn signal on this long before departure
+  double backward_path_update_duration{3.0};         // [s] a re-sent request re-plans at most this often
 };
 
 // Whether this version of the core implements a planner (search_priority may only name these).
@@ -110,7 +119,7 @@ struct RequestLimits {
   std::size_t max_predicted_paths{16};         // per object
   std::size_t max_predicted_path_points{200};  // per predicted path
   std::size_t max_route_lanelets{1000};
-  std::size_t max_grid_cells{16u * 1024u * 1024u};
+  std::size_t max_grid_cells{std::size_t{16} * 1024 * 1024};
   double max_deadline_ms{10000.0};
 };
 

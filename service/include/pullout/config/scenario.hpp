@@ -11,13 +11,17 @@
 //   start_velocity: 0.0                       # optional [m/s]
 //   goal:  {x: 90.0, y: 0.0, yaw_deg: 0.0}
 //   objects:
-//     - {id: 7, class: car, x: 20.0, y: 3.5, yaw_deg: 0, length: 4.5, width: 1.9, velocity: 0.0}
+//     - {id: 7, class: car, x: 20.0, y: 3.5, yaw_deg: 0, length: 4.5, width: 1.9, velocity: 0.0,
+//        predicted_paths: [{time_step: 1.0, confidence: 1.0, points: [[20, 3.5], [20, 3.5]]}]}
+//        # optional; each pose heads to the next point. Without one, the safety check assumes
+//        # constant velocity along the object's heading.
 //   planner:                                  # any start_planner parameter, overriding the config
 //     search_priority: [shift]
 //   deadline_ms: 200                          # optional
 //   vehicle_id: demo-1                        # optional
 //   description: "..."                        # optional, free text
-//   expect: {found: true, planner: shift}     # optional, used by tests
+//   expect: {found: true, planner: shift, safe: true}   # optional, used by tests; safe: the
+//                                             # safety verdict at the start, before departure
 #pragma once
 
 #include <memory>
@@ -35,6 +39,8 @@ struct ScenarioExpectation {
   std::optional<bool> found;
   std::optional<PlannerType> planner;
   std::optional<double> margin_m;  // the collision margin the winning attempt used
+  // The dynamic safety verdict for the found path at the start, before departure (approved).
+  std::optional<bool> safe;
 };
 
 struct Scenario {
