@@ -12,6 +12,7 @@
 #include "pullout/client/client.hpp"
 #include "pullout/config/config.hpp"
 #include "pullout/config/scenario.hpp"
+#include "pullout/maps/lanelet_map.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/deadline.hpp"
 #include "pullout/pipeline/parameters.hpp"
@@ -31,6 +32,8 @@ constexpr const char* kDefaultVehicleId = "pullout-cli";
 constexpr auto kWaitSlice = std::chrono::milliseconds(100);
 // After the final status, how long to wait for the path at least (it is published alongside).
 constexpr auto kPathGrace = std::chrono::seconds(1);
+// [m] The SVG draws a scenario map's lanelets this close to the vehicle.
+constexpr double kSvgMapRadius = 60.0;
 
 std::atomic<bool> g_interrupted{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
@@ -38,8 +41,10 @@ static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs 
 extern "C" void handle_interrupt(int /*signal*/) { g_interrupted.store(true); }
 
 // Renders the report on `out` (text or JSON) and writes the SVG. Returns the exit code.
-int emit(const PlanReport& report, const PullOutRequest& request, const VehicleInfo& vehicle,
-         const std::string& scenario_file, const OutputOptions& options, std::ostream& out, std::ostream& err) {
+int emit(const PlanReport& report, const Scenario& scenario, const std::string& scenario_file,
+         const OutputOptions& options, std::ostream& out, std::ostream& err) {
+  const PullOutRequest& request = scenario.request;
+  const VehicleInfo& vehicle = scenario.vehicle;
   if (options.json) {
     // Strings from the service may hold invalid UTF-8: replace rather than throw.
     out << to_json(report).dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
@@ -49,6 +54,11 @@ int emit(const PlanReport& report, const PullOutRequest& request, const VehicleI
   if (!options.svg_file.empty()) {
     SvgOptions svg;
     svg.title = scenario_file + (report.found ? "  (" + std::string(to_string(report.planner)) + ")" : "  (no path)");
+    if (scenario.map) {
+      for (std::size_t i : scenario.map->lanelets_near({request.ego_pose.x, request.ego_pose.y}, kSvgMapRadius)) {
+        if (auto lane = to_lane(scenario.map->lanelet(i))) svg.map_lanes.push_back(std::move(*lane));
+      }
+    }
     try {
       write_text_file(options.svg_file, render_svg(request, vehicle, report.path ? &*report.path : nullptr, svg));
     } catch (const std::exception& e) {
@@ -101,12 +111,12 @@ int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
 
-  const StartPlanner planner(scenario.vehicle, scenario.parameters, config.service.limits);
+  const StartPlanner planner(scenario.vehicle, scenario.parameters, config.service.limits, scenario.map);
   // The service's budget rule: the request's deadline, else the configured default.
   const double budget_ms =
       scenario.request.deadline_ms > 0.0 ? scenario.request.deadline_ms : config.service.default_deadline_ms;
   const PlanningResult result = planner.plan(scenario.request, Deadline::after_ms(budget_ms));
-  return emit(make_report(result), scenario.request, scenario.vehicle, options.scenario_file, options.output, out, err);
+  return emit(make_report(result), scenario, options.scenario_file, options.output, out, err);
 }
 
 int run_request(const RequestOptions& options, std::ostream& out, std::ostream& err) {
@@ -174,8 +184,7 @@ int run_request(const RequestOptions& options, std::ostream& out, std::ostream& 
       return kExitCommunication;
     }
   }
-  return emit(make_report(path, *status), scenario.request, scenario.vehicle, options.scenario_file, options.output,
-              out, err);
+  return emit(make_report(path, *status), scenario, options.scenario_file, options.output, out, err);
 }
 
 }  // namespace pullout::cli

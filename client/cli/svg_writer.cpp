@@ -25,6 +25,7 @@ constexpr double kMaxScalePxPerM = 60.0;
 constexpr const char* kRoadFill = "#d9d9d9";
 constexpr const char* kShoulderFill = "#f2e2b3";
 constexpr const char* kLaneStroke = "#8c8c8c";
+constexpr const char* kRouteStroke = "#262626";
 constexpr const char* kObjectFill = "#ff7875";
 constexpr const char* kObjectStroke = "#a8071a";
 constexpr const char* kStartStroke = "#0050b3";
@@ -153,21 +154,36 @@ struct LegendEntry {
   std::string label;
 };
 
-std::vector<LegendEntry> legend_entries(const PullOutRequest& request, const PullOutPath* path) {
+bool on_route(const PullOutRequest& request, const Lane& lane) {
+  return std::find(request.route_lanelet_ids.begin(), request.route_lanelet_ids.end(), lane.id) !=
+         request.route_lanelet_ids.end();
+}
+
+std::vector<LegendEntry> legend_entries(const PullOutRequest& request, const PullOutPath* path,
+                                        const std::vector<Lane>& map_lanes) {
   std::vector<LegendEntry> entries;
   const auto box = [](const std::string& style) {
     return "<rect x=\"0\" y=\"0\" width=\"16\" height=\"12\" " + style + "/>";
   };
-  const bool has_road = std::any_of(request.lanes.begin(), request.lanes.end(),
-                                    [](const Lane& l) { return l.subtype == LaneSubtype::kRoad; });
-  const bool has_shoulder = std::any_of(request.lanes.begin(), request.lanes.end(),
-                                        [](const Lane& l) { return l.subtype == LaneSubtype::kRoadShoulder; });
+  const auto any = [&](LaneSubtype subtype) {
+    const auto is = [subtype](const Lane& l) { return l.subtype == subtype; };
+    return std::any_of(request.lanes.begin(), request.lanes.end(), is) ||
+           std::any_of(map_lanes.begin(), map_lanes.end(), is);
+  };
+  const bool has_road = any(LaneSubtype::kRoad);
+  const bool has_shoulder = any(LaneSubtype::kRoadShoulder);
+  const bool has_route =
+      std::any_of(map_lanes.begin(), map_lanes.end(), [&](const Lane& l) { return on_route(request, l); });
   if (has_road) {
     entries.push_back({box(std::string("fill=\"") + kRoadFill + "\" stroke=\"" + kLaneStroke + "\""), "road lane"});
   }
   if (has_shoulder) {
     entries.push_back(
         {box(std::string("fill=\"") + kShoulderFill + "\" stroke=\"" + kLaneStroke + "\""), "road shoulder"});
+  }
+  if (has_route) {
+    entries.push_back(
+        {box(std::string("fill=\"") + kRoadFill + "\" stroke=\"" + kRouteStroke + "\" stroke-width=\"2\""), "route"});
   }
   if (!request.objects.empty()) {
     entries.push_back({box(std::string("fill=\"") + kObjectFill + "\" stroke=\"" + kObjectStroke + "\""), "object"});
@@ -242,6 +258,10 @@ std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle
                        const SvgOptions& options) {
   // --- what is drawn, and its bounding box ---
   Bounds bounds;
+  for (const auto& lane : options.map_lanes) {
+    bounds.add_all(lane.left_bound);
+    bounds.add_all(lane.right_bound);
+  }
   for (const auto& lane : request.lanes) {
     bounds.add_all(lane.left_bound);
     bounds.add_all(lane.right_bound);
@@ -271,7 +291,7 @@ std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle
   const double drawing_w = width_m * f.scale;
   const double drawing_h = height_m * f.scale;
 
-  const std::vector<LegendEntry> legend = legend_entries(request, path);
+  const std::vector<LegendEntry> legend = legend_entries(request, path, options.map_lanes);
   const double legend_h = kLegendRowPx * static_cast<double>(legend.size() + 1);
   const double total_w = kMarginPx + drawing_w + kMarginPx + kLegendWidthPx;
   const double total_h = f.top + std::max(drawing_h + kScaleBarHeightPx, legend_h) + kMarginPx;
@@ -289,6 +309,17 @@ std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle
   }
   svg << "  <rect class=\"frame\" x=\"" << num(kMarginPx) << "\" y=\"" << num(f.top) << "\" width=\"" << num(drawing_w)
       << "\" height=\"" << num(drawing_h) << "\" fill=\"none\" stroke=\"#bfbfbf\"/>\n";
+
+  svg << "  <g id=\"map\">\n";
+  for (const auto& lane : options.map_lanes) {
+    const bool shoulder = lane.subtype == LaneSubtype::kRoadShoulder;
+    const bool route = on_route(request, lane);
+    svg << "    <polygon class=\"" << (shoulder ? "map-shoulder" : "map-road") << (route ? " route" : "")
+        << "\" data-id=\"" << lane.id << "\" points=\"" << points_attr(f, lane_outline(lane)) << "\" fill=\""
+        << (shoulder ? kShoulderFill : kRoadFill) << "\" stroke=\"" << (route ? kRouteStroke : kLaneStroke)
+        << "\" stroke-width=\"" << (route ? "2" : "1") << "\"/>\n";
+  }
+  svg << "  </g>\n";
 
   svg << "  <g id=\"lanes\">\n";
   for (const auto& lane : request.lanes) {

@@ -1,4 +1,5 @@
-// An SVG picture of a pull-out: lanes (filled, shoulders in a sandy tone), objects, the vehicle
+// An SVG picture of a pull-out: lanes (filled, shoulders in a sandy tone; map lanelets around the
+// vehicle for a route request, the route outlined), objects, the vehicle
 // footprint at the start (request ego pose) and at the end (path end pose, found paths only),
 // each partial path in its own colour (reverse segments dashed), the goal, a legend and a scale
 // bar.
@@ -24,6 +25,9 @@ struct SvgOptions {
   double max_drawing_width_px{1000.0};  // the map part, without legend
   double max_drawing_height_px{800.0};
   std::string title;  // shown at the top; empty: none
+  // Lanelets of a Lanelet2 map around the vehicle, drawn under everything else (with the road and
+  // shoulder colours); those whose id is in the request's route_lanelet_ids get a dark outline.
+  std::vector<Lane> map_lanes;
 };
 
 // Corners of the vehicle's footprint at `pose` (base_link = rear-axle centre), counter-clockwise

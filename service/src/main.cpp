@@ -2,14 +2,16 @@
 //
 //   pullout_service --config config/pullout.yaml [--domain N] [--log-level L]
 //
-// Exit codes: 0 after SIGINT/SIGTERM, 1 bad command line or config, 2 DDS setup failed, 3 any
+// Exit codes: 0 after SIGINT/SIGTERM, 1 bad command line, config or map, 2 DDS setup failed, 3 any
 // other start-up failure. Everything is built inside one try block; a failure prints one line per
 // problem and exits.
 #include <pthread.h>
 #include <signal.h>
+#include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <exception>
+#include <memory>
 #include <string>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -17,6 +19,8 @@
 #include <CLI/CLI.hpp>
 
 #include "pullout/config/config.hpp"
+#include "pullout/maps/lanelet_map.hpp"
+#include "pullout/maps/osm_loader.hpp"
 #include "pullout/model/names.hpp"
 #include "service/pullout_service.hpp"
 
@@ -86,12 +90,27 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "pullout_service: %s: %s\n", config_path.c_str(), e.what());
     return kExitConfig;
   }
+  // The map is read once, before any DDS entity exists: a bad map stops the service with one line.
+  std::shared_ptr<const pullout::LaneletMap> map;
+  if (!config.map.path.empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      map = pullout::load_lanelet_map(config.map.path);
+    } catch (const pullout::MapLoadError& e) {
+      std::fprintf(stderr, "pullout_service: invalid map (map.path): %s\n", e.what());
+      return kExitConfig;
+    }
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    spdlog::info("map {}: {} lanelets ({} road, {} road_shoulder) loaded in {:.1f} ms", config.map.path,
+                 map->lanelets().size(), map->count(pullout::LaneletSubtype::kRoad),
+                 map->count(pullout::LaneletSubtype::kRoadShoulder), ms);
+  }
   if (domain_id >= 0) config.dds.domain_id = domain_id;
   if (!log_level.empty()) config.service.log_level = log_level;
   spdlog::set_level(spdlog::level::from_str(config.service.log_level));
 
   try {
-    pullout::service::PulloutService service(config);
+    pullout::service::PulloutService service(config, map);
     service.start();
     spdlog::info("pullout_service ready: domain {}, participant profile '{}' from {}, {} planning thread(s)",
                  config.dds.domain_id, config.dds.participant_profile, config.dds.profiles_file,

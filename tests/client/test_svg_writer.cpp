@@ -238,5 +238,28 @@ TEST(WriteTextFile, WritesAndReportsFailures) {
   EXPECT_THROW(write_text_file("/nonexistent-dir/x.svg", "<svg/>"), std::runtime_error);
 }
 
+TEST(SvgWriter, DrawsMapLaneletsAndOutlinesTheRoute) {
+  // A route request: no inline lanes; the map's lanelets around the vehicle come in the options.
+  PullOutRequest request = scene();
+  SvgOptions options;
+  options.map_lanes = request.lanes;
+  options.map_lanes.push_back(request.lanes[0]);
+  options.map_lanes.back().id = 3;
+  for (auto& p : options.map_lanes.back().left_bound) p.x += 60.0;
+  for (auto& p : options.map_lanes.back().right_bound) p.x += 60.0;
+  request.lanes.clear();
+  request.route_lanelet_ids = {1, 3};
+  Parsed parsed;
+  parse(render_svg(request, VehicleInfo{}, nullptr, options), parsed);
+  EXPECT_EQ(with_class(parsed, "map-road route").size(), 2u);
+  EXPECT_EQ(with_class(parsed, "map-shoulder").size(), 1u);
+  EXPECT_NE(all_text(parsed).find("route"), std::string::npos);
+  EXPECT_NE(all_text(parsed).find("road shoulder"), std::string::npos);
+  // The picture spans the map lanelets (120 m at most 1000 px wide): lane 3 ends inside it.
+  const auto far = points_of(with_class(parsed, "map-road route")[1]);
+  const double width = std::stod(parsed.root->Attribute("width"));
+  for (const Point2& p : far) EXPECT_LT(p.x, width);
+}
+
 }  // namespace
 }  // namespace pullout::cli

@@ -409,6 +409,28 @@ TEST(Config, ObjectTypesToCheckIncludes) {
 namespace pullout {
 namespace {
 
+TEST(ConfigMap, PathIsResolvedRelativeToTheConfigFile) {
+  ConfigFile file(std::string(kMinimal) + "map: {path: maps/town.osm}\n");
+  std::filesystem::create_directories(file.dir() / "maps");
+  std::ofstream(file.dir() / "maps" / "town.osm") << "<osm/>\n";
+  const Config c = load_config(file.path());
+  EXPECT_EQ(c.map.path, (file.dir() / "maps" / "town.osm").string());
+}
+
+TEST(ConfigMap, EmptyOrAbsentMeansNoMap) {
+  EXPECT_TRUE(load_config(kShippedConfig).map.path.empty());
+  EXPECT_TRUE(problems_of(std::string(kMinimal) + "map: {path: \"\"}\n").empty());
+}
+
+TEST(ConfigMap, MissingFileAndUnknownKeysAreNamed) {
+  auto p = problems_of(std::string(kMinimal) + "map: {path: nowhere.osm}\n");
+  EXPECT_TRUE(any_starts_with(p, "map.path: file not found")) << dump(p);
+  p = problems_of(std::string(kMinimal) + "map: {path: \"\", origin: 3}\n");
+  EXPECT_TRUE(any_starts_with(p, "map.origin: unknown key")) << dump(p);
+  p = problems_of(std::string(kMinimal) + "map: {path: [1, 2]}\n");
+  EXPECT_TRUE(any_starts_with(p, "map.path:")) << dump(p);
+}
+
 TEST(Config, SafetySectionsLoadWithAutowareNames) {
   const Config d;
   const Config shipped = load_config(kShippedConfig);

@@ -8,8 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "pullout/maps/lanelet_map.hpp"
 
 namespace pullout {
 namespace {
@@ -93,7 +96,8 @@ TEST(Scenario, EveryScenarioInTheSuiteLoads) {
     ++count;
     try {
       const Scenario s = load_scenario(entry.path().string());
-      EXPECT_FALSE(s.request.lanes.empty()) << entry.path();
+      // Inline lanes, or a route on the scenario's map.
+      EXPECT_TRUE(!s.request.lanes.empty() || (s.map && !s.request.route_lanelet_ids.empty())) << entry.path();
     } catch (const ConfigError& e) {
       ADD_FAILURE() << e.what();
     }
@@ -189,10 +193,37 @@ TEST(Scenario, MissingRequiredParts) {
   EXPECT_TRUE(any_starts_with(q, "lanes[0].right_bound: required")) << dump(q);
 }
 
-TEST(Scenario, MapAndRouteAreNotSupportedYet) {
-  const auto p = problems_of(std::string(kPoses) + "map: maps/test.osm\nroute: [4618, 4635]\n");
-  EXPECT_TRUE(any_starts_with(p, "map: lanelet2 maps are not supported yet")) << dump(p);
-  EXPECT_TRUE(any_starts_with(p, "route: routes on a lanelet2 map are not supported yet")) << dump(p);
+TEST(Scenario, MapAndRouteLoadTheMap) {
+  const Scenario sc = load_scenario(kScenarioDir + "/map_shoulder.yaml");
+  ASSERT_TRUE(sc.map);
+  EXPECT_EQ(sc.map_path, std::filesystem::path(std::string(PULLOUT_SOURCE_DIR) + "/tests/maps/straight_shoulder.osm")
+                             .lexically_normal()
+                             .string());
+  EXPECT_EQ(sc.request.route_lanelet_ids, (std::vector<std::int64_t>{101, 102, 103}));
+  EXPECT_TRUE(sc.request.lanes.empty());
+  EXPECT_EQ(sc.map->lanelets().size(), 7u);
+}
+
+TEST(Scenario, MapAndRouteProblems) {
+  auto p = problems_of(std::string(kPoses) + "map: /nonexistent/map.osm\nroute: [4618, 4635]\n");
+  EXPECT_TRUE(any_starts_with(p, "map: /nonexistent/map.osm: cannot read file")) << dump(p);
+  const std::string own_map = std::string(PULLOUT_SOURCE_DIR) + "/tests/maps/straight_shoulder.osm";
+  p = problems_of(std::string(kPoses) + "map: " + own_map + "\n");
+  EXPECT_TRUE(any_starts_with(p, "route: required with map:")) << dump(p);
+  p = problems_of(std::string(kPoses) + "map: " + own_map + "\nroute: [101, x]\n");
+  EXPECT_TRUE(any_starts_with(p, "route[1]: expected")) << dump(p);
+  p = problems_of(std::string(kPoses) + kLanes + "route: [101]\n");
+  EXPECT_TRUE(any_starts_with(p, "lanes: give either inline lanes or a route")) << dump(p);
+  // A malformed map file: the scenario names it.
+  const std::string broken_map =
+      (std::filesystem::temp_directory_path() / ("pullout_broken_map_" + std::to_string(::getpid()) + ".osm")).string();
+  std::ofstream(broken_map) << "<osm><node id=\"1\"></osm>\n";
+  p = problems_of(std::string(kPoses) + "map: " + broken_map + "\nroute: [1]\n");
+  std::filesystem::remove(broken_map);
+  EXPECT_TRUE(any_starts_with(p, "map: " + broken_map + ": line 1: not valid XML")) << dump(p);
+  // A route without a map is for a service that has the map.
+  p = problems_of(std::string(kPoses) + "route: [101, 102]\n");
+  EXPECT_TRUE(p.empty()) << dump(p);
 }
 
 TEST(Scenario, PlannerSectionIsValidated) {

@@ -232,6 +232,10 @@ LaneChain LaneWorld::chain_through(std::size_t seed) const {
     order.push_back(next);
     cur = next;
   }
+  return chain_of(order);
+}
+
+LaneChain LaneWorld::chain_of(const std::vector<std::size_t>& order) const {
   LaneChain chain;
   chain.lanes = order;
   std::vector<Vec2> pts;

@@ -9,6 +9,8 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/lanes/lane_world.hpp"
+#include "pullout/maps/lanelet_map.hpp"
+#include "pullout/maps/map_lanes.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/planners/clothoid_pull_out.hpp"
 #include "pullout/planners/geometric_pull_out.hpp"
@@ -19,6 +21,50 @@
 namespace pullout {
 
 namespace {
+
+// [m] Road kept behind the start beyond max_back_distance (Autoware's backward_path_length).
+constexpr double kBackwardPathLength = 5.0;
+// [m] A route passing farther than this from the start is not the one to pull out onto.
+constexpr double kMaxRouteDistance = 10.0;
+
+// The lanes one request plans on: its inline lanes, or those picked on the map for its route
+// (with the road and pull-out lanes in driving order).
+struct RequestLanes {
+  std::vector<Lane> from_map;
+  const std::vector<Lane>* lanes{nullptr};
+  std::vector<std::int64_t> road_ids;      // map requests: the road lanes
+  std::vector<std::int64_t> pull_out_ids;  // map requests: the shoulder lanes (empty: the road)
+  std::vector<RequestIssue> issues;
+};
+
+RequestLanes request_lanes(const PullOutRequest& request, const LaneletMap* map, const VehicleInfo& vehicle,
+                           const StartPlannerParameters& params) {
+  RequestLanes out;
+  if (request.route_lanelet_ids.empty() || map == nullptr) {
+    out.lanes = &request.lanes;
+    return out;
+  }
+  MapLaneOptions options;
+  options.backward_length_m = kBackwardPathLength + params.max_back_distance;
+  options.forward_length_m = params.forward_path_length;
+  options.start_tolerance_m = vehicle.width_m() / 2.0;
+  options.max_route_distance_m = kMaxRouteDistance;
+  MapLanes selected = select_map_lanes(*map, request, options);
+  out.issues = std::move(selected.issues);
+  out.from_map = std::move(selected.lanes);
+  out.lanes = &out.from_map;
+  out.road_ids = std::move(selected.road_ids);
+  out.pull_out_ids = std::move(selected.pull_out_ids);
+  return out;
+}
+
+std::vector<std::size_t> indices_of(const LaneWorld& world, const std::vector<std::int64_t>& ids) {
+  std::vector<std::size_t> out;
+  for (std::int64_t id : ids) {
+    if (const auto i = world.find(id)) out.push_back(*i);
+  }
+  return out;
+}
 
 const std::vector<PlannerType>& available_planners() {
   static const std::vector<PlannerType> kAvailable{PlannerType::kShift, PlannerType::kGeometric,
@@ -109,13 +155,16 @@ bool planner_available(PlannerType type) {
   return std::find(a.begin(), a.end(), type) != a.end();
 }
 
-StartPlanner::StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits)
-    : vehicle_(vehicle), parameters_(std::move(parameters)), limits_(limits) {}
+StartPlanner::StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits,
+                           std::shared_ptr<const LaneletMap> map)
+    : vehicle_(vehicle), parameters_(std::move(parameters)), limits_(limits), map_(std::move(map)) {}
 
 std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) const {
-  auto issues = validate_request_structure(request, limits_, available_planners());
+  auto issues = validate_request_structure(request, limits_, available_planners(), map_ != nullptr);
   if (!issues.empty()) return issues;
-  const LaneWorld world(request.lanes);
+  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_);
+  if (!lanes.issues.empty()) return lanes.issues;
+  const LaneWorld world(*lanes.lanes);
   if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) issues.push_back(*issue);
   return issues;
 }
@@ -130,13 +179,20 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     r.path.stamp_ns = request.stamp_ns;
   };
 
-  result.issues = validate_request_structure(request, limits_, available_planners());
+  result.issues = validate_request_structure(request, limits_, available_planners(), map_ != nullptr);
   if (!result.issues.empty()) {
     result.outcome = PlanningResult::Outcome::kRejected;
     finish(result);
     return result;
   }
-  const LaneWorld world(request.lanes);
+  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_);
+  if (!lanes.issues.empty()) {
+    result.issues = lanes.issues;
+    result.outcome = PlanningResult::Outcome::kRejected;
+    finish(result);
+    return result;
+  }
+  const LaneWorld world(*lanes.lanes);
   if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) {
     result.issues.push_back(*issue);
     result.outcome = PlanningResult::Outcome::kRejected;
@@ -148,9 +204,12 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   if (!request.overrides.search_priority.empty()) params.search_priority = request.overrides.search_priority;
   if (request.overrides.search_policy) params.search_policy = *request.overrides.search_policy;
 
-  // The road lanes to pull out onto: the chain through the road lane nearest to the vehicle.
-  const auto seed = world.nearest_lane(to_vec(request.ego_pose), LaneSubtype::kRoad);
-  const LaneChain road = world.chain_through(*seed);  // validation guarantees a road lane
+  // The road lanes to pull out onto: the map's pick for the route, or the chain through the road
+  // lane nearest to the vehicle.
+  const bool from_map = !lanes.road_ids.empty();
+  const LaneChain road = from_map
+                             ? world.chain_of(indices_of(world, lanes.road_ids))
+                             : world.chain_through(*world.nearest_lane(to_vec(request.ego_pose), LaneSubtype::kRoad));
 
   // Static obstacles: objects slower than th_moving_object_velocity, of the classes to check.
   // All of them are considered, wherever they stand (Autoware keeps only those overlapping the
@@ -165,11 +224,18 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   // The lanes the vehicle stands in: the shoulder chain when it is on a shoulder, else the road.
   LaneChain shoulder;
   const LaneChain* pull_out = &road;
-  for (std::size_t i : world.lanes_containing(to_vec(request.ego_pose))) {
-    if (world.lanes()[i].subtype == LaneSubtype::kRoadShoulder) {
-      shoulder = world.chain_through(i);
+  if (from_map) {
+    if (!lanes.pull_out_ids.empty()) {
+      shoulder = world.chain_of(indices_of(world, lanes.pull_out_ids));
       pull_out = &shoulder;
-      break;
+    }
+  } else {
+    for (std::size_t i : world.lanes_containing(to_vec(request.ego_pose))) {
+      if (world.lanes()[i].subtype == LaneSubtype::kRoadShoulder) {
+        shoulder = world.chain_through(i);
+        pull_out = &shoulder;
+        break;
+      }
     }
   }
   double horizon = 0.0;

@@ -9,8 +9,8 @@
 namespace pullout {
 
 // Checks that need no world: finite numbers, sizes within the limits, non-degenerate lanes,
-// known planners.
+// known planners; route ids only when a map is loaded (`has_map`), and not together with lanes.
 std::vector<RequestIssue> validate_request_structure(const PullOutRequest& request, const RequestLimits& limits,
-                                                     const std::vector<PlannerType>& available);
+                                                     const std::vector<PlannerType>& available, bool has_map);
 
 }  // namespace pullout

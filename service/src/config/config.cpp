@@ -280,6 +280,26 @@ void apply_dds(const YAML::Node& node, DdsConfig& out, Problems& problems) {
   r.finish();
 }
 
+void apply_map(const YAML::Node& node, MapConfig& out, Problems& problems) {
+  MapReader r(node, "map", problems);
+  if (!r.valid()) return;
+  r.read("path", out.path);
+  r.finish();
+}
+
+void validate_map(MapConfig& m, const std::filesystem::path& config_dir, Problems& problems) {
+  if (m.path.empty()) return;
+  std::filesystem::path file(m.path);
+  if (file.is_relative()) file = config_dir / file;
+  file = file.lexically_normal();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    problems.push_back("map.path: file not found: " + file.string());
+    return;
+  }
+  m.path = file.string();
+}
+
 void validate_service(const ServiceConfig& s, Problems& problems) {
   constexpr int kMaxWorkers = 64;
   if (s.worker_threads < 1 || s.worker_threads > kMaxWorkers) {
@@ -460,12 +480,14 @@ Config load_config(const std::string& path) {
     apply_start_planner_parameters(root.get("start_planner"), "start_planner", config.start_planner, problems);
     apply_service(root.get("service"), config.service, problems);
     apply_dds(root.get("dds"), config.dds, problems);
+    apply_map(root.get("map"), config.map, problems);
     root.finish();
 
     append_parameter_issues(validate_vehicle(config.vehicle), "vehicle", problems);
     append_parameter_issues(validate_parameters(config.start_planner), "start_planner", problems);
     validate_service(config.service, problems);
     validate_dds(config.dds, std::filesystem::path(path).parent_path(), problems);
+    validate_map(config.map, std::filesystem::path(path).parent_path(), problems);
   }
   if (!problems.empty()) throw ConfigError(path, std::move(problems));
   return config;

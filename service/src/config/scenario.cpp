@@ -9,6 +9,7 @@
 
 #include "config/config_detail.hpp"
 #include "config/yaml_fields.hpp"
+#include "pullout/maps/osm_loader.hpp"
 #include "pullout/model/names.hpp"
 
 namespace pullout {
@@ -243,18 +244,35 @@ Scenario load_scenario(const std::string& path, const Config& base) {
     apply_vehicle_info(root.get("vehicle"), "vehicle", s.vehicle, problems);
     append_parameter_issues(validate_vehicle(s.vehicle), "vehicle", problems);
   }
-  if (root.has("map")) {
-    root.get("map");
-    problems.push_back("map: lanelet2 maps are not supported yet: give the lanes inline (lanes:)");
+  std::string map_file;
+  if (root.read("map", map_file)) {
+    std::filesystem::path file(map_file);
+    if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
+    s.map_path = file.lexically_normal().string();
+    try {
+      s.map = load_lanelet_map(s.map_path);
+    } catch (const MapLoadError& e) {
+      problems.push_back(std::string("map: ") + e.what());
+    }
   }
-  if (root.has("route")) {
-    root.get("route");
-    problems.push_back("route: routes on a lanelet2 map are not supported yet: give the lanes inline (lanes:)");
+  request.route_lanelet_ids =
+      read_list<std::int64_t>(root, "route", [&](const YAML::Node& n, const std::string& p, std::size_t) {
+        return yaml_fields::to_int(n, p, problems).value_or(0);
+      });
+  if (root.has("route") && request.route_lanelet_ids.empty())
+    problems.push_back("route: must name at least one lanelet");
+  if (root.has("map") && !root.has("route")) {
+    problems.push_back("route: required with map: (the road lanelet ids to pull out onto, in driving order)");
   }
 
   request.lanes = read_list<Lane>(
       root, "lanes", [&](const YAML::Node& n, const std::string& p, std::size_t) { return read_lane(n, p, problems); });
-  if (!root.has("lanes") && !root.has("map")) problems.push_back("lanes: required (the inline lanes)");
+  if (root.has("lanes") && root.has("route")) {
+    problems.push_back("lanes: give either inline lanes or a route (map: and route:), not both");
+  }
+  if (!root.has("lanes") && !root.has("route")) {
+    problems.push_back("lanes: required (the inline lanes, or map: and route: for a Lanelet2 map)");
+  }
 
   request.ego_pose = read_pose(root, "start", true);
   root.read("start_velocity", request.ego_velocity_mps);

@@ -41,10 +41,10 @@ const char* outcome_name(PlanningResult::Outcome o) {
 
 }  // namespace
 
-PulloutService::PulloutService(const Config& config)
+PulloutService::PulloutService(const Config& config, std::shared_ptr<const LaneletMap> map)
     : config_(config),
       dds_(config.dds),
-      planner_(config.vehicle, config.start_planner, config.service.limits),
+      planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
       registry_(config.vehicle, config.start_planner, dds_) {
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
 }
@@ -147,8 +147,13 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
     registry_.reject(request.vehicle_id, request.request_id, issues);
     return;
   }
-  spdlog::info("vehicle '{}' request {}: accepted ({} lanes, {} objects)", request.vehicle_id, request.request_id,
-               request.lanes.size(), request.objects.size());
+  if (request.route_lanelet_ids.empty()) {
+    spdlog::info("vehicle '{}' request {}: accepted ({} lanes, {} objects)", request.vehicle_id, request.request_id,
+                 request.lanes.size(), request.objects.size());
+  } else {
+    spdlog::info("vehicle '{}' request {}: accepted (route of {} lanelets, {} objects)", request.vehicle_id,
+                 request.request_id, request.route_lanelet_ids.size(), request.objects.size());
+  }
   std::optional<PlanningJob> job = registry_.accept(std::move(request));
   if (!job) return;  // objects of a latched path updated
   const std::string vehicle = job->request.vehicle_id;

@@ -36,8 +36,9 @@ namespace pullout::service {
 class PulloutService {
  public:
   // Creates the DDS entities (throws DdsSetupError) and the planning threads. `config` must be
-  // valid (load_config validates it).
-  explicit PulloutService(const Config& config);
+  // valid (load_config validates it). `map`: the Lanelet2 map of config.map.path (null: none);
+  // requests naming route lanelets plan on it.
+  explicit PulloutService(const Config& config, std::shared_ptr<const LaneletMap> map = nullptr);
   ~PulloutService();
   PulloutService(const PulloutService&) = delete;
   PulloutService& operator=(const PulloutService&) = delete;

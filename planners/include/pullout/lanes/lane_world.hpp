@@ -63,6 +63,9 @@ class LaneWorld {
   // The chain of lanes through `seed`, following predecessors back and successors forward (the
   // first one when there are several), without cycles.
   LaneChain chain_through(std::size_t seed) const;
+  // The chain of the given lanes in the given order (indices into lanes(); expected to be
+  // connected, e.g. a route on a map).
+  LaneChain chain_of(const std::vector<std::size_t>& order) const;
 
   // True when the footprint (corners counter-clockwise) lies inside the union of the lanes: every
   // corner is inside some lane and no footprint edge crosses the outer boundary of the union.

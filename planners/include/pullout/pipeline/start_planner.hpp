@@ -10,8 +10,14 @@
 // Outcome::kRejected with one issue per problem (naming the field), "no path" gives
 // Outcome::kNoPath with a stop path and the reasons, and an expired deadline gives kNoPath with
 // timed_out = true.
+//
+// Lanes come either inline (request.lanes) or from the Lanelet2 map given at construction:
+// request.route_lanelet_ids then names the road lanelets to pull out onto, and the pipeline plans
+// on the lanes select_map_lanes (maps/map_lanes.hpp) picks around the vehicle. A request with
+// route ids and no map, or with both lanes and route ids, is rejected.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,6 +27,8 @@
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace pullout {
+
+class LaneletMap;
 
 // "field: problem" lines joined by '\n'.
 std::string format_issues(const std::vector<RequestIssue>& issues);
@@ -40,8 +48,10 @@ struct PlanningResult {
 
 class StartPlanner {
  public:
-  // Parameters must be valid (validate_parameters / validate_vehicle return nothing).
-  StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits = {});
+  // Parameters must be valid (validate_parameters / validate_vehicle return nothing). `map` may be
+  // null (no map: only inline lanes are accepted).
+  StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits = {},
+               std::shared_ptr<const LaneletMap> map = nullptr);
 
   // Plans for one request. Applies the request's overrides (search_priority, search_policy) to
   // a copy of the parameters. Never throws for bad input.
@@ -53,11 +63,13 @@ class StartPlanner {
   const VehicleInfo& vehicle() const { return vehicle_; }
   const StartPlannerParameters& parameters() const { return parameters_; }
   const RequestLimits& limits() const { return limits_; }
+  const std::shared_ptr<const LaneletMap>& map() const { return map_; }
 
  private:
   VehicleInfo vehicle_;
   StartPlannerParameters parameters_;
   RequestLimits limits_;
+  std::shared_ptr<const LaneletMap> map_;
 };
 
 }  // namespace pullout

@@ -1,10 +1,11 @@
 // Loading and validating config/pullout.yaml.
 //
-// The file has four sections: `vehicle` (VehicleInfo fields without the unit suffix, e.g.
+// The file has five sections: `vehicle` (VehicleInfo fields without the unit suffix, e.g.
 // wheel_base), `start_planner` (StartPlannerParameters, Autoware's names), `service` (workers,
-// default deadline, request limits, log level) and `dds` (domain id, XML profiles file, participant
-// profile). Every key is optional (the struct defaults apply) but an unknown key, a value of the
-// wrong type or an out-of-range value is an error. load_config() reports every problem at once.
+// default deadline, request limits, log level), `dds` (domain id, XML profiles file, participant
+// profile) and `map` (the Lanelet2 map file; its content is loaded by the service, not here). Every key is optional
+// (the struct defaults apply) but an unknown key, a value of the wrong type or an out-of-range value is an error.
+// load_config() reports every problem at once.
 #pragma once
 
 #include <stdexcept>
@@ -33,11 +34,18 @@ struct ServiceConfig {
   std::string log_level{"info"};  // trace, debug, info, warn, error, critical, off
 };
 
+struct MapConfig {
+  // Lanelet2 OSM file (Autoware format) that route requests refer to; relative paths are relative
+  // to the config file, and load_config makes them absolute. Empty: no map (inline lanes only).
+  std::string path;
+};
+
 struct Config {
   VehicleInfo vehicle;
   StartPlannerParameters start_planner;
   ServiceConfig service;
   DdsConfig dds;
+  MapConfig map;
 };
 
 // Thrown by load_config / load_scenario with one line per problem: "<file>: <key path>: <problem>".

@@ -1,7 +1,9 @@
 // Scenario files: one YAML format for the CLI, the tests and the benchmarks (see DESIGN.md).
 //
 //   vehicle: {wheel_base: 2.79, ...}          # optional, overrides the config's vehicle
-//   lanes:                                    # inline lanes (or map + route, not yet supported)
+//   map: ../maps/straight_shoulder.osm        # Lanelet2 map, relative to this file ...
+//   route: [101, 102, 103]                    # ... and the road lanelets to pull out onto, or:
+//   lanes:                                    # inline lanes
 //     - {id: 1, subtype: road, speed_limit: 13.9,
 //        left_bound: [[0, 1.75], [100, 1.75]], right_bound: [[0, -1.75], [100, -1.75]],
 //        centerline: [[0, 0], [100, 0]]}       # centerline optional
@@ -22,6 +24,7 @@
 //                                             # safety verdict at the start, before departure
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -29,6 +32,8 @@
 #include "pullout/model/types.hpp"
 
 namespace pullout {
+
+class LaneletMap;
 
 struct ScenarioExpectation {
   std::optional<bool> found;
@@ -41,15 +46,18 @@ struct ScenarioExpectation {
 struct Scenario {
   std::string path;  // the file it was loaded from
   std::string description;
-  PullOutRequest request;             // vehicle_id, ego pose, goal, lanes, objects, deadline
-  VehicleInfo vehicle;                // base config's vehicle with the scenario's overrides
-  StartPlannerParameters parameters;  // base config's parameters with `planner:` applied
+  PullOutRequest request;                 // vehicle_id, ego pose, goal, lanes or route, objects, deadline
+  std::string map_path;                   // `map:` made absolute; empty when the scenario has none
+  std::shared_ptr<const LaneletMap> map;  // loaded from map_path (null without)
+  VehicleInfo vehicle;                    // base config's vehicle with the scenario's overrides
+  StartPlannerParameters parameters;      // base config's parameters with `planner:` applied
   ScenarioExpectation expect;
 };
 
-// Loads a scenario on top of `base` (vehicle and start_planner come from it unless overridden).
-// Throws ConfigError naming every malformed field ("<file>: lanes[0].left_bound[3]: expected
-// [x, y]") or if the file cannot be read.
+// Loads a scenario on top of `base` (vehicle and start_planner come from it unless overridden),
+// and its map when it names one. Throws ConfigError naming every malformed field ("<file>:
+// lanes[0].left_bound[3]: expected [x, y]", "<file>: map: <map file>: <problem>") or if the file
+// cannot be read. A `route:` without `map:` is allowed: a running service plans it on its own map.
 Scenario load_scenario(const std::string& path, const Config& base = Config{});
 
 }  // namespace pullout
