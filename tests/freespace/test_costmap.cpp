@@ -54,7 +54,7 @@ TEST(Costmap, OccupancyGridThresholdAndUnknown) {
   EXPECT_FALSE(m.occupied(1, 0));
   EXPECT_TRUE(m.occupied(2, 0));
   EXPECT_TRUE(m.occupied(3, 0));
-  EXPECT_TRUE(m.occupied(4, 0));  // unknown is an obstacle
+  EXPECT_TRUE(m.occupied(4, 0));   // unknown is an obstacle
   EXPECT_TRUE(m.occupied(-1, 0));  // outside the grid too
   EXPECT_TRUE(m.occupied(0, 1));
 }
@@ -92,7 +92,8 @@ TEST(Costmap, DistanceTransformMatchesBruteForce) {
 TEST(Costmap, PolygonsRasteriseConservatively) {
   // A 10 m x 4 m lane, a 1 m box obstacle inside it; 0.25 m cells over a 12 x 6 m extent.
   const Polygon lane{{1, 1}, {11, 1}, {11, 5}, {1, 5}};
-  const std::vector<std::pair<Vec2, Vec2>> outline{{{1, 1}, {11, 1}}, {{11, 1}, {11, 5}}, {{11, 5}, {1, 5}}, {{1, 5}, {1, 1}}};
+  const std::vector<std::pair<Vec2, Vec2>> outline{
+      {{1, 1}, {11, 1}}, {{11, 1}, {11, 5}}, {{11, 5}, {1, 5}}, {{1, 5}, {1, 1}}};
   const Polygon box{{5.1, 2.1}, {6.1, 2.1}, {6.1, 3.1}, {5.1, 3.1}};
   Aabb extent;
   extent.extend({0, 0});
@@ -131,7 +132,8 @@ TEST(GridCollisionChecker, ExactAtTheMillimetre) {
     // distance gap from the cell's corner (20, 20) along the diagonal.
     const double yaw = M_PI / 4.0 - std::atan2(fp.left, fp.front);
     const Vec2 target = Vec2{20.0, 20.0} - gap * Vec2{1.0, 1.0}.normalized();
-    const Vec2 corner{std::cos(yaw) * fp.front - std::sin(yaw) * fp.left, std::sin(yaw) * fp.front + std::cos(yaw) * fp.left};
+    const Vec2 corner{std::cos(yaw) * fp.front - std::sin(yaw) * fp.left,
+                      std::sin(yaw) * fp.front + std::cos(yaw) * fp.left};
     const Vec2 base = target - corner;
     EXPECT_EQ(checker.collides({base.x(), base.y(), yaw}), gap < 0.0) << "corner gap " << gap;
   }

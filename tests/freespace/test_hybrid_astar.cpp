@@ -18,7 +18,8 @@ Costmap walled_map(double w, double h, const std::vector<Polygon>& boxes = {}) {
   const int ch = static_cast<int>(std::round(h / kRes));
   std::vector<std::uint8_t> occ(static_cast<std::size_t>(cw * ch), 0);
   for (int i = 0; i < cw; ++i) occ[static_cast<std::size_t>(i)] = occ[static_cast<std::size_t>((ch - 1) * cw + i)] = 1;
-  for (int j = 0; j < ch; ++j) occ[static_cast<std::size_t>(j * cw)] = occ[static_cast<std::size_t>(j * cw + cw - 1)] = 1;
+  for (int j = 0; j < ch; ++j)
+    occ[static_cast<std::size_t>(j * cw)] = occ[static_cast<std::size_t>(j * cw + cw - 1)] = 1;
   Costmap m({}, kRes, cw, ch, std::move(occ));
   m.add_obstacles(boxes);
   return m;
@@ -110,8 +111,7 @@ TEST(HybridAStar, TypedFailures) {
   EXPECT_EQ(planner.plan({14, 10, 0}, {25, 10, 0}, Deadline()).status, HybridAStarResult::Status::kStartOccupied);
   EXPECT_EQ(planner.plan({5, 10, 0}, {14.5, 20, 0}, Deadline()).status, HybridAStarResult::Status::kGoalOccupied);
   EXPECT_EQ(planner.plan({5, 10, 0}, {-50, 10, 0}, Deadline()).status, HybridAStarResult::Status::kGoalOccupied);
-  EXPECT_EQ(planner.plan({5, 10, 0}, {25, 10, 0}, Deadline::after_ms(5000)).status,
-            HybridAStarResult::Status::kNoPath);
+  EXPECT_EQ(planner.plan({5, 10, 0}, {25, 10, 0}, Deadline::after_ms(5000)).status, HybridAStarResult::Status::kNoPath);
 }
 
 TEST(HybridAStar, DeadlineGivesATimeoutPromptly) {

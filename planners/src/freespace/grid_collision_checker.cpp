@@ -86,7 +86,8 @@ bool GridCollisionChecker::collides_exact(const Pose2& pose, double c, double s)
   double x_lo = y_lo;
   double x_hi = -y_lo;
   for (std::size_t i = 0; i < 4; ++i) {
-    g[i] = costmap_.to_grid({pose.x + c * local[i].x() - s * local[i].y(), pose.y + s * local[i].x() + c * local[i].y()});
+    g[i] =
+        costmap_.to_grid({pose.x + c * local[i].x() - s * local[i].y(), pose.y + s * local[i].x() + c * local[i].y()});
     y_lo = std::min(y_lo, g[i].y());
     y_hi = std::max(y_hi, g[i].y());
     x_lo = std::min(x_lo, g[i].x());

@@ -137,7 +137,8 @@ class Search {
     const double dy = p.y - goal_.y;
     const double lon = c * dx + s * dy;
     const double lat = -s * dx + c * dy;
-    return std::abs(lon) <= 0.5 * config_.longitudinal_goal_range && std::abs(lat) <= 0.5 * config_.lateral_goal_range &&
+    return std::abs(lon) <= 0.5 * config_.longitudinal_goal_range &&
+           std::abs(lat) <= 0.5 * config_.lateral_goal_range &&
            std::abs(wrap(p.yaw - goal_.yaw)) <= 0.5 * config_.angle_goal_range;
   }
 
@@ -182,7 +183,8 @@ class Search {
     std::vector<ReedsSheppPath> words = rs_.all(node.pose, goal_);
     std::vector<std::pair<double, std::size_t>> order;
     order.reserve(words.size());
-    for (std::size_t i = 0; i < words.size(); ++i) order.emplace_back(weighted_cost(words[i], weights_, node.direction), i);
+    for (std::size_t i = 0; i < words.size(); ++i)
+      order.emplace_back(weighted_cost(words[i], weights_, node.direction), i);
     std::sort(order.begin(), order.end());
     for (int tried = 0; tried < kShotCandidates && tried < static_cast<int>(order.size()); ++tried) {
       const ReedsSheppPath& p = words[order[static_cast<std::size_t>(tried)].second];

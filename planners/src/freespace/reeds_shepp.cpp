@@ -239,7 +239,8 @@ class Enumerator {
       for (int i = 0; i < len.n / 2; ++i) std::swap(kinds[static_cast<std::size_t>(i)], kinds[len.n - 1 - i]);
     }
     if (reflect) {
-      for (int i = 0; i < len.n; ++i) kinds[static_cast<std::size_t>(i)] = static_cast<Kind>(-static_cast<int>(kinds[i]));
+      for (int i = 0; i < len.n; ++i)
+        kinds[static_cast<std::size_t>(i)] = static_cast<Kind>(-static_cast<int>(kinds[i]));
     }
     visit_(kinds, lengths, len.n);
   }

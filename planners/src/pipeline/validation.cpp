@@ -134,7 +134,7 @@ void validate_object(Checker& c, const std::string& f, const Object& o, const Re
 }  // namespace
 
 std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, const RequestLimits& limits,
-                                                     const std::vector<PlannerType>& available) {
+                                                     const std::vector<PlannerType>& available, bool allow_grid_only) {
   std::vector<RequestIssue> issues;
   Checker c(limits, issues);
   if (r.vehicle_id.empty()) c.add("vehicle_id", "empty");
@@ -153,8 +153,9 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
   if (!r.route_lanelet_ids.empty()) {
     c.count("route_lanelet_ids", r.route_lanelet_ids.size(), limits.max_route_lanelets, "lanelets");
     c.add("route_lanelet_ids", "no Lanelet2 map is loaded by this planner: send inline lanes instead");
-  } else if (r.lanes.empty()) {
-    c.add("lanes", "empty: send at least one lane of subtype road");
+  } else if (r.lanes.empty() && !(allow_grid_only && r.occupancy_grid)) {
+    c.add("lanes", allow_grid_only ? "empty: send at least one lane of subtype road, or an occupancy grid"
+                                   : "empty: send at least one lane of subtype road");
   }
   if (c.count("lanes", r.lanes.size(), limits.max_lanes, "lanes")) {
     std::unordered_set<std::int64_t> ids;

@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "config/config_detail.hpp"
+#include "config/grid_file.hpp"
 #include "config/yaml_fields.hpp"
 #include "pullout/model/names.hpp"
 
@@ -219,7 +220,15 @@ Scenario load_scenario(const std::string& path, const Config& base) {
 
   request.lanes = read_list<Lane>(
       root, "lanes", [&](const YAML::Node& n, const std::string& p, std::size_t) { return read_lane(n, p, problems); });
-  if (!root.has("lanes") && !root.has("map")) problems.push_back("lanes: required (the inline lanes)");
+  if (root.has("grid")) {
+    OccupancyGrid grid;
+    if (read_scenario_grid(root, std::filesystem::path(path).parent_path().string(), grid)) {
+      request.occupancy_grid = std::move(grid);
+    }
+  }
+  if (!root.has("lanes") && !root.has("map") && !root.has("grid")) {
+    problems.push_back("lanes: required (the inline lanes, or a grid for a pure freespace problem)");
+  }
 
   request.ego_pose = read_pose(root, "start", true);
   root.read("start_velocity", request.ego_velocity_mps);
