@@ -107,7 +107,9 @@ TEST(Costmap, PolygonsRasteriseConservatively) {
   m.cell_of({3.1, 3.1}, i, j);
   EXPECT_FALSE(m.occupied(i, j));  // inside
   m.cell_of({1.1, 3.1}, i, j);
-  EXPECT_TRUE(m.occupied(i, j));  // the cell [1.0, 1.25] is touched by the outline at x = 1
+  EXPECT_FALSE(m.occupied(i, j));  // the cell [1.0, 1.25] lies inside; the outline only bounds it
+  m.cell_of({0.9, 3.1}, i, j);
+  EXPECT_TRUE(m.occupied(i, j));  // [0.75, 1.0] lies outside
   m.cell_of({5.05, 2.5}, i, j);
   EXPECT_TRUE(m.occupied(i, j));  // [5.0, 5.25] overlaps the box from x = 5.1
   m.cell_of({4.9, 2.5}, i, j);

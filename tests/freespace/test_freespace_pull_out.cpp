@@ -64,7 +64,8 @@ TEST_P(FreespaceScenario, FindsADrivablePath) {
       freespace_costmap(fp, sc.request.occupancy_grid ? &*sc.request.occupancy_grid : nullptr, &world, objects,
                         sc.request.ego_pose, fp.end_pose_search_end_distance + sc.vehicle.length_m() + 10.0);
   const GridCollisionChecker checker(costmap, freespace_footprint(sc.vehicle, fp));
-  const double k_max = 1.0 / (sc.vehicle.wheel_base_m / std::tan(sc.vehicle.max_steer_angle_rad * fp.max_turning_ratio));
+  const double k_max =
+      1.0 / (sc.vehicle.wheel_base_m / std::tan(sc.vehicle.max_steer_angle_rad * fp.max_turning_ratio));
   const Footprint body = vehicle_footprint(sc.vehicle);
 
   int cusps = 0;

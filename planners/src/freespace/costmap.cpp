@@ -146,14 +146,17 @@ void Costmap::add_obstacles(const std::vector<Polygon>& polygons) {
       y_lo = std::min(y_lo, g.back().y());
       y_hi = std::max(y_hi, g.back().y());
     }
-    const int j0 = std::max(0, static_cast<int>(std::floor(y_lo)));
-    const int j1 = std::min(height_ - 1, static_cast<int>(std::floor(y_hi)));
+    // A cell is marked when the polygon meets its interior: a polygon that ends exactly on a
+    // cell boundary (a wall 0.4 m thick on 0.2 m cells) does not mark the next cell.
+    constexpr double kInterior = 1e-9;  // [cells]
+    const int j0 = std::max(0, static_cast<int>(std::floor(y_lo + kInterior)));
+    const int j1 = std::min(height_ - 1, static_cast<int>(std::floor(y_hi - kInterior)));
     for (int j = j0; j <= j1; ++j) {
       double x0 = 0.0;
       double x1 = 0.0;
-      if (!strip_extent(g.data(), g.size(), j, j + 1.0, x0, x1)) continue;
-      const int i0 = std::max(0, static_cast<int>(std::floor(x0)));
-      const int i1 = std::min(width_ - 1, static_cast<int>(std::floor(x1)));
+      if (!strip_extent(g.data(), g.size(), j + kInterior, j + 1.0 - kInterior, x0, x1)) continue;
+      const int i0 = std::max(0, static_cast<int>(std::floor(x0 + kInterior)));
+      const int i1 = std::min(width_ - 1, static_cast<int>(std::floor(x1 - kInterior)));
       for (int i = i0; i <= i1; ++i) occupied_[index(i, j)] = 1;
     }
   }

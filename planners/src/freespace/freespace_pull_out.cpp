@@ -11,9 +11,9 @@ namespace pullout {
 namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-constexpr double kTrimDistance = 1.0;       // [m] Autoware's trim around the end pose
-constexpr double kSamePose = 1e-6;          // [m]
-constexpr double kWindowExtra = 10.0;       // [m] costmap window beyond the farthest end pose
+constexpr double kTrimDistance = 1.0;  // [m] Autoware's trim around the end pose
+constexpr double kSamePose = 1e-6;     // [m]
+constexpr double kWindowExtra = 10.0;  // [m] costmap window beyond the farthest end pose
 
 Deadline search_deadline(const FreespaceParameters& p, const Deadline& deadline) {
   const Deadline own = Deadline::after_ms(p.time_limit);
@@ -165,8 +165,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
     candidate.clearance = clearance.distance;
     candidate.nearest_obstacle = clearance.obstacle_id;
     const PlanningContext* c = &ctx;
-    candidate.build = [c, waypoints = std::move(r.waypoints), exact = r.reached_exact_goal, end_pose, s_end,
-                       s_ego]() {
+    candidate.build = [c, waypoints = std::move(r.waypoints), exact = r.reached_exact_goal, end_pose, s_end, s_ego]() {
       const FreespaceParameters& fp = c->parameters.freespace_planner;
       SplitPath split = split_at_cusps(waypoints, fp.velocity);
       const std::int64_t fallback_id = road_lane_id_at(*c, s_ego);

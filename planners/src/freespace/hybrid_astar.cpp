@@ -17,6 +17,7 @@ constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
 constexpr std::size_t kDeadlineCheckInterval = 16;  // expansions between clock reads
 constexpr int kShotCandidates = 3;                  // Reeds-Shepp words tried per shot, cheapest first
 constexpr double kShotDistancePerInterval = 4.0;    // [m] heuristic distance per expansion between shots
+constexpr double kReedsSheppRange = 4.0;            // [turning radii] see heuristic()
 constexpr double kCoarseSpacing = 1.0;              // [m] first-pass sample spacing of a shot
 
 double wrap(double a) {
@@ -124,9 +125,13 @@ class Search {
   // Plain Reeds-Shepp length: the cost weights make the true cost larger still, but a weighted
   // Reeds-Shepp bound steers the search into obstacles the 2D distance goes around (measured:
   // 20x more expansions around a wall).
+  // Far from the goal the 2D distance dominates (a Reeds-Shepp path exceeds the straight line by
+  // at most a few turning radii, and obstacles lengthen the 2D distance): the Reeds-Shepp term,
+  // the costliest part of an expansion, is only computed within kReedsSheppRange radii.
   double heuristic(const Pose2& p) const {
     const double h2d = heuristic_.distance(p);
     if (!std::isfinite(h2d)) return h2d;
+    if (h2d > kReedsSheppRange * config_.turning_radius) return config_.distance_heuristic_weight * h2d;
     return config_.distance_heuristic_weight * std::max(h2d, rs_.distance(p, goal_));
   }
 

@@ -78,7 +78,8 @@ bool read_pgm(const std::string& file, PgmImage& out, std::vector<std::string>& 
     }
     for (std::size_t i = 0; i < n; ++i) {
       const auto b0 = static_cast<unsigned char>(data[pos + i * bytes]);
-      out.pixels[i] = bytes == 1 ? b0 : static_cast<std::uint16_t>((b0 << 8) | static_cast<unsigned char>(data[pos + i * 2 + 1]));
+      out.pixels[i] =
+          bytes == 1 ? b0 : static_cast<std::uint16_t>((b0 << 8) | static_cast<unsigned char>(data[pos + i * 2 + 1]));
     }
   } else {
     std::string t;

@@ -42,8 +42,9 @@ class Costmap {
                                const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
                                const std::vector<Polygon>& obstacles);
 
-  // Marks every cell a polygon (map frame) overlaps as occupied (conservative; non-convex
-  // polygons are filled row by row between their extreme points). Updates the precomputation.
+  // Marks every cell whose interior a polygon (map frame) meets as occupied (conservative;
+  // non-convex polygons are filled row by row between their extreme points; a segment marks the
+  // cells it passes through). Updates the precomputation.
   void add_obstacles(const std::vector<Polygon>& polygons);
 
   bool empty() const { return width_ == 0 || height_ == 0; }

@@ -67,7 +67,7 @@ struct FreespaceGoalResult {
   PullOutPath path;  // found: partial paths to the goal (end_pose = goal)
 };
 FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const VehicleInfo& vehicle,
-                                           const FreespaceParameters& parameters, const Pose2& start,
-                                           const Pose2& goal, const Deadline& deadline);
+                                           const FreespaceParameters& parameters, const Pose2& start, const Pose2& goal,
+                                           const Deadline& deadline);
 
 }  // namespace pullout
