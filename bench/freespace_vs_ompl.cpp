@@ -132,7 +132,7 @@ Problem make_problem(int index, std::mt19937& rng, const pullout::Footprint& fp)
     const double inward = -b.faces;  // +y or -y into the bay
     const double yaw = inward > 0 ? kPi / 2 : -kPi / 2;
     if (nose_in) return Pose2{b.x, b.y_open + inward * (0.3 + fp.rear), yaw};
-    return Pose2{b.x, b.y_open + inward * (0.3 + fp.front), yaw + kPi};
+    return Pose2{b.x, b.y_open + inward * (0.3 + fp.front), std::remainder(yaw + kPi, 2.0 * kPi)};
   };
   std::shuffle(empty.begin(), empty.end(), rng);
   p.start = parked(bays[empty[0]], true);
