@@ -47,11 +47,11 @@ namespace og = ompl::geometric;
 using pullout::Pose2;
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kBayWidth = 2.7;   // [m]
-constexpr double kBayDepth = 5.5;   // [m]
-constexpr double kAisle = 7.0;      // [m]
-constexpr double kWall = 0.4;       // [m]
-constexpr double kMargin = 0.1;     // [m] footprint growth on each side
+constexpr double kBayWidth = 2.7;  // [m]
+constexpr double kBayDepth = 5.5;  // [m]
+constexpr double kAisle = 7.0;     // [m]
+constexpr double kWall = 0.4;      // [m]
+constexpr double kMargin = 0.1;    // [m] footprint growth on each side
 
 struct Problem {
   std::string name;
@@ -211,9 +211,9 @@ Run run_ompl(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   }
   ss.setup();
   const auto t0 = std::chrono::steady_clock::now();
-  const ob::PlannerTerminationCondition ptc = ob::plannerOrTerminationCondition(
-      ob::timedPlannerTerminationCondition(budget_ms / 1000.0),
-      ob::exactSolnPlannerTerminationCondition(ss.getProblemDefinition()));
+  const ob::PlannerTerminationCondition ptc =
+      ob::plannerOrTerminationCondition(ob::timedPlannerTerminationCondition(budget_ms / 1000.0),
+                                        ob::exactSolnPlannerTerminationCondition(ss.getProblemDefinition()));
   const ob::PlannerStatus status = ss.solve(ptc);
   Run run;
   run.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -278,8 +278,8 @@ int main(int argc, char** argv) {
       std::printf("%-18s invalid start or goal (generator bug)\n", p.name.c_str());
       return 1;
     }
-    const Run r[3] = {run_ours(p, checker, radius, budget_ms, heuristic_weight), run_ompl(p, checker, radius, budget_ms, false),
-                      run_ompl(p, checker, radius, budget_ms, true)};
+    const Run r[3] = {run_ours(p, checker, radius, budget_ms, heuristic_weight),
+                      run_ompl(p, checker, radius, budget_ms, false), run_ompl(p, checker, radius, budget_ms, true)};
     std::printf("%-18s", p.name.c_str());
     for (int k = 0; k < 3; ++k) {
       runs[k].push_back(r[k]);
@@ -292,7 +292,9 @@ int main(int argc, char** argv) {
     std::printf("\n");
     if (p.size == 30.0 && p.resolution > 0.15 && r[0].success) small_ours.push_back(r[0].time_ms);
   }
-  std::printf("\n| planner | success | median time to first solution [ms] | p95 [ms] | mean length [m] | mean direction changes |\n");
+  std::printf(
+      "\n| planner | success | median time to first solution [ms] | p95 [ms] | mean length [m] | mean direction "
+      "changes |\n");
   std::printf("|---|---|---|---|---|---|\n");
   for (int k = 0; k < 3; ++k) {
     std::vector<double> t;
