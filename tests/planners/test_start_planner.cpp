@@ -23,6 +23,7 @@ const StartPlanner& shift_only_planner() {
     StartPlannerParameters p;
     p.enable_back = false;
     p.search_priority = {PlannerType::kShift};
+    p.freespace_planner.enable_freespace_planner = false;
     return StartPlanner(VehicleInfo{}, p);
   }();
   return planner;
@@ -107,7 +108,7 @@ TEST(StartPlanner, ExpiredDeadlineEndsTheSearchWithTimeout) {
 
 TEST(StartPlanner, SearchPolicyOverrideAndUnavailablePlanner) {
   auto req = test::straight_shoulder_request();
-  req.overrides.search_priority = {PlannerType::kFreespace};
+  req.overrides.search_priority = {PlannerType::kStop};  // not a planner that can be searched
   const PlanningResult r = default_planner().plan(req, Deadline());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
   EXPECT_TRUE(has_issue(r, "overrides.search_priority[0]"));

@@ -130,6 +130,29 @@ TEST(Config, ShippedConfigLoadsWithTheStructDefaults) {
   EXPECT_DOUBLE_EQ(p.clothoid_max_steer_angle_rate_deg_per_sec, q.clothoid_max_steer_angle_rate_deg_per_sec);
   EXPECT_DOUBLE_EQ(p.clothoid_collision_check_distance_from_end, q.clothoid_collision_check_distance_from_end);
   EXPECT_EQ(p.check_clothoid_path_lane_departure, q.check_clothoid_path_lane_departure);
+  const FreespaceParameters& f = p.freespace_planner;
+  const FreespaceParameters& g = q.freespace_planner;
+  EXPECT_EQ(f.enable_freespace_planner, g.enable_freespace_planner);
+  EXPECT_DOUBLE_EQ(f.end_pose_search_start_distance, g.end_pose_search_start_distance);
+  EXPECT_DOUBLE_EQ(f.end_pose_search_end_distance, g.end_pose_search_end_distance);
+  EXPECT_DOUBLE_EQ(f.end_pose_search_interval, g.end_pose_search_interval);
+  EXPECT_DOUBLE_EQ(f.velocity, g.velocity);
+  EXPECT_DOUBLE_EQ(f.vehicle_shape_margin, g.vehicle_shape_margin);
+  EXPECT_DOUBLE_EQ(f.time_limit, g.time_limit);
+  EXPECT_DOUBLE_EQ(f.max_turning_ratio, g.max_turning_ratio);
+  EXPECT_EQ(f.turning_steps, g.turning_steps);
+  EXPECT_EQ(f.search_configs.theta_size, g.search_configs.theta_size);
+  EXPECT_DOUBLE_EQ(f.search_configs.angle_goal_range, g.search_configs.angle_goal_range);
+  EXPECT_DOUBLE_EQ(f.search_configs.lateral_goal_range, g.search_configs.lateral_goal_range);
+  EXPECT_DOUBLE_EQ(f.search_configs.longitudinal_goal_range, g.search_configs.longitudinal_goal_range);
+  EXPECT_DOUBLE_EQ(f.search_configs.curve_weight, g.search_configs.curve_weight);
+  EXPECT_DOUBLE_EQ(f.search_configs.reverse_weight, g.search_configs.reverse_weight);
+  EXPECT_DOUBLE_EQ(f.search_configs.direction_change_weight, g.search_configs.direction_change_weight);
+  EXPECT_EQ(f.costmap_configs.obstacle_threshold, g.costmap_configs.obstacle_threshold);
+  EXPECT_DOUBLE_EQ(f.costmap_configs.resolution, g.costmap_configs.resolution);
+  EXPECT_EQ(f.astar.use_back, g.astar.use_back);
+  EXPECT_DOUBLE_EQ(f.astar.distance_heuristic_weight, g.astar.distance_heuristic_weight);
+  EXPECT_DOUBLE_EQ(f.astar.expansion_distance, g.astar.expansion_distance);
 
   EXPECT_EQ(c.service.worker_threads, d.service.worker_threads);
   EXPECT_DOUBLE_EQ(c.service.default_deadline_ms, d.service.default_deadline_ms);
@@ -211,6 +234,31 @@ TEST(Config, ShippedConfigSetsEveryKey) {
                           "clothoid_max_steer_angle_rate_deg_per_sec",
                           "clothoid_collision_check_distance_from_end",
                           "check_clothoid_path_lane_departure",
+                          "freespace_planner",
+                          "enable_freespace_planner",
+                          "end_pose_search_start_distance",
+                          "end_pose_search_end_distance",
+                          "end_pose_search_interval",
+                          "velocity",
+                          "vehicle_shape_margin",
+                          "time_limit",
+                          "max_turning_ratio",
+                          "turning_steps",
+                          "search_configs",
+                          "theta_size",
+                          "angle_goal_range",
+                          "lateral_goal_range",
+                          "longitudinal_goal_range",
+                          "curve_weight",
+                          "reverse_weight",
+                          "direction_change_weight",
+                          "costmap_configs",
+                          "obstacle_threshold",
+                          "resolution",
+                          "astar",
+                          "use_back",
+                          "distance_heuristic_weight",
+                          "expansion_distance",
                           "worker_threads",
                           "default_deadline_ms",
                           "log_level",
@@ -354,6 +402,30 @@ TEST(Config, SearchPriorityProblems) {
 
   const auto t = problems_of(std::string(kMinimal) + "start_planner: {search_priority: [stop]}\n");
   EXPECT_TRUE(any_starts_with(t, "start_planner.search_priority[0]: 'stop' is not a planner")) << dump(t);
+}
+
+TEST(Config, FreespaceKeysAreReadAndChecked) {
+  ConfigFile ok(std::string(kMinimal) +
+                "start_planner:\n  freespace_planner:\n    enable_freespace_planner: false\n"
+                "    search_configs: {theta_size: 72}\n    astar: {use_back: false}\n");
+  const Config c = load_config(ok.path());
+  EXPECT_FALSE(c.start_planner.freespace_planner.enable_freespace_planner);
+  EXPECT_EQ(c.start_planner.freespace_planner.search_configs.theta_size, 72);
+  EXPECT_FALSE(c.start_planner.freespace_planner.astar.use_back);
+
+  const auto p = problems_of(std::string(kMinimal) +
+                             "start_planner:\n  freespace_planner:\n    time_limit: -1\n"
+                             "    end_pose_search_start_distance: 30\n    end_pose_search_end_distance: 20\n"
+                             "    search_configs: {theta_size: 3, bogus: 1}\n"
+                             "    freespace_planner_algorithm: rrtstar\n");
+  EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.time_limit: must be in")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.end_pose_search_end_distance: must be >="))
+      << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.search_configs.theta_size: must be in")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.search_configs.bogus: unknown key")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.freespace_planner_algorithm: Autoware parameter"))
+      << dump(p);
+  EXPECT_EQ(p.size(), 5u) << dump(p);
 }
 
 TEST(Config, MissingProfilesFileIsAnError) {

@@ -53,6 +53,15 @@ std::vector<std::string> problems_of(const std::string& text) {
   return {};
 }
 
+std::vector<std::string> problems_of_file(const std::string& path) {
+  try {
+    load_scenario(path);
+  } catch (const ConfigError& e) {
+    return e.problems();
+  }
+  return {};
+}
+
 bool any_starts_with(const std::vector<std::string>& lines, const std::string& prefix) {
   return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.rfind(prefix, 0) == 0; });
 }
@@ -96,8 +105,10 @@ TEST(Scenario, EveryScenarioInTheSuiteLoads) {
     ++count;
     try {
       const Scenario s = load_scenario(entry.path().string());
-      // Inline lanes, or a route on the scenario's map.
-      EXPECT_TRUE(!s.request.lanes.empty() || (s.map && !s.request.route_lanelet_ids.empty())) << entry.path();
+      // Inline lanes, a route on the scenario's map, or a grid for a pure freespace problem.
+      EXPECT_TRUE(!s.request.lanes.empty() || (s.map && !s.request.route_lanelet_ids.empty()) ||
+                  s.request.occupancy_grid.has_value())
+          << entry.path();
     } catch (const ConfigError& e) {
       ADD_FAILURE() << e.what();
     }
@@ -232,6 +243,60 @@ TEST(Scenario, PlannerSectionIsValidated) {
   EXPECT_TRUE(any_starts_with(p, "planner.search_priority[1]: planner 'shift' is listed twice")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "planner.lateral_jerk: must be > 0")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "vehicle.wheel_base: must be in")) << dump(p);
+}
+
+TEST(Scenario, GridFromObstacleShapes) {
+  ScenarioFile file(std::string(kPoses) +
+                    "grid:\n  resolution: 0.5\n  origin: {x: -1.0, y: -2.0}\n  size: [10, 5]\n"
+                    "  obstacles:\n    - {x: 2.0, y: 0.0, length: 1.0, width: 1.0}\n"
+                    "    - {polygon: [[6.1, -1.9], [7.9, -1.9], [7.9, -1.1]]}\n");
+  const Scenario s = load_scenario(file.path());
+  ASSERT_TRUE(s.request.occupancy_grid.has_value());
+  const OccupancyGrid& g = *s.request.occupancy_grid;
+  EXPECT_EQ(g.width, 20u);
+  EXPECT_EQ(g.height, 10u);
+  EXPECT_DOUBLE_EQ(g.origin.x, -1.0);
+  const auto at = [&](double x, double y) {
+    return g.data[static_cast<std::size_t>((y + 2.0) / 0.5) * g.width + static_cast<std::size_t>((x + 1.0) / 0.5)];
+  };
+  EXPECT_EQ(at(2.0, 0.0), 100);   // inside the box [1.5, 2.5] x [-0.5, 0.5]
+  EXPECT_EQ(at(1.4, 0.0), 0);     // the cell [1.0, 1.5] touches it only at x = 1.5
+  EXPECT_EQ(at(7.0, -1.6), 100);  // the triangle
+  EXPECT_EQ(at(5.0, 2.0), 0);
+  EXPECT_TRUE(s.request.lanes.empty());
+}
+
+TEST(Scenario, GridFromAMapServerImage) {
+  // A 4 x 3 P2 image: black (occupied), white (free), grey (unknown); the top row first.
+  const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_map_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "lot.pgm") << "P2\n# a comment\n4 3\n255\n0 255 255 255\n255 128 255 255\n255 255 255 0\n";
+  std::ofstream(dir / "lot.yaml") << "image: lot.pgm\nresolution: 0.5\norigin: [1.0, 2.0, 0.0]\n"
+                                     "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n";
+  std::ofstream(dir / "scenario.yaml") << kPoses << "grid: {map: lot.yaml}\n";
+  const Scenario s = load_scenario((dir / "scenario.yaml").string());
+  ASSERT_TRUE(s.request.occupancy_grid.has_value());
+  const OccupancyGrid& g = *s.request.occupancy_grid;
+  EXPECT_EQ(g.width, 4u);
+  EXPECT_EQ(g.height, 3u);
+  EXPECT_DOUBLE_EQ(g.origin.y, 2.0);
+  // Grid row 0 is the image's bottom row.
+  EXPECT_EQ(g.data[0 * 4 + 3], 100);
+  EXPECT_EQ(g.data[0 * 4 + 0], 0);
+  EXPECT_EQ(g.data[1 * 4 + 1], -1);
+  EXPECT_EQ(g.data[2 * 4 + 0], 100);
+
+  // P5 (binary) gives the same grid.
+  std::ofstream(dir / "lot.pgm", std::ios::binary)
+      << "P5\n4 3\n255\n"
+      << std::string("\x00\xff\xff\xff\xff\x80\xff\xff\xff\xff\xff\x00", 12);
+  const Scenario b = load_scenario((dir / "scenario.yaml").string());
+  EXPECT_EQ(b.request.occupancy_grid->data, g.data);
+
+  std::ofstream(dir / "lot.yaml") << "image: missing.pgm\nresolution: 0.5\norigin: [1.0, 2.0]\n";
+  const auto p = problems_of_file((dir / "scenario.yaml").string());
+  EXPECT_TRUE(any_starts_with(p, "grid.map.origin: required")) << dump(p);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Scenario, UnreadableFile) {

@@ -222,6 +222,44 @@ std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p)
   c.in_range("extra_width_margin_for_rear_obstacle", p.extra_width_margin_for_rear_obstacle, 0.0, 10.0);
   c.in_range("prepare_time_before_start", p.prepare_time_before_start, 0.0, 60.0);
   c.in_range("backward_path_update_duration", p.backward_path_update_duration, 0.0, 600.0);
+  {  // freespace_planner.*
+    const FreespaceParameters& f = p.freespace_planner;
+    const std::string fp = "freespace_planner.";
+    c.in_range(fp + "end_pose_search_start_distance", f.end_pose_search_start_distance, 0.0, 500.0);
+    c.in_range(fp + "end_pose_search_end_distance", f.end_pose_search_end_distance, 0.0, 500.0);
+    if (std::isfinite(f.end_pose_search_start_distance) && std::isfinite(f.end_pose_search_end_distance) &&
+        f.end_pose_search_end_distance < f.end_pose_search_start_distance) {
+      c.fail(fp + "end_pose_search_end_distance", "must be >= end_pose_search_start_distance (" +
+                                                      text(f.end_pose_search_start_distance) + "), got " +
+                                                      text(f.end_pose_search_end_distance));
+    }
+    c.in_range(fp + "end_pose_search_interval", f.end_pose_search_interval, 0.1, 100.0);
+    c.in_range(fp + "velocity", f.velocity, 0.01, 20.0);
+    c.in_range(fp + "vehicle_shape_margin", f.vehicle_shape_margin, 0.0, 5.0);
+    c.in_range(fp + "time_limit", f.time_limit, 1.0, 60000.0);
+    c.in_range(fp + "max_turning_ratio", f.max_turning_ratio, 0.05, 1.0);
+    if (f.turning_steps < 1 || f.turning_steps > 10) {
+      c.fail(fp + "turning_steps", "must be in [1, 10], got " + std::to_string(f.turning_steps));
+    }
+    const std::string sc = fp + "search_configs.";
+    if (f.search_configs.theta_size < 8 || f.search_configs.theta_size > 720) {
+      c.fail(sc + "theta_size", "must be in [8, 720], got " + std::to_string(f.search_configs.theta_size));
+    }
+    c.in_range(sc + "angle_goal_range", f.search_configs.angle_goal_range, 0.1, 180.0);
+    c.in_range(sc + "lateral_goal_range", f.search_configs.lateral_goal_range, 0.0, 10.0);
+    c.in_range(sc + "longitudinal_goal_range", f.search_configs.longitudinal_goal_range, 0.0, 20.0);
+    c.in_range(sc + "curve_weight", f.search_configs.curve_weight, 0.0, 100.0);
+    c.in_range(sc + "reverse_weight", f.search_configs.reverse_weight, 0.0, 100.0);
+    c.in_range(sc + "direction_change_weight", f.search_configs.direction_change_weight, 0.0, 1000.0);
+    const std::string cc = fp + "costmap_configs.";
+    if (f.costmap_configs.obstacle_threshold < 1 || f.costmap_configs.obstacle_threshold > 100) {
+      c.fail(cc + "obstacle_threshold",
+             "must be in [1, 100], got " + std::to_string(f.costmap_configs.obstacle_threshold));
+    }
+    c.in_range(cc + "resolution", f.costmap_configs.resolution, 0.02, 2.0);
+    c.in_range(fp + "astar.distance_heuristic_weight", f.astar.distance_heuristic_weight, 0.1, 10.0);
+    c.in_range(fp + "astar.expansion_distance", f.astar.expansion_distance, 0.05, 10.0);
+  }
   return issues;
 }
 

@@ -8,6 +8,7 @@
 
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
+#include "pullout/freespace/freespace_pull_out.hpp"
 #include "pullout/lanes/lane_world.hpp"
 #include "pullout/maps/lanelet_map.hpp"
 #include "pullout/maps/map_lanes.hpp"
@@ -67,8 +68,8 @@ std::vector<std::size_t> indices_of(const LaneWorld& world, const std::vector<st
 }
 
 const std::vector<PlannerType>& available_planners() {
-  static const std::vector<PlannerType> kAvailable{PlannerType::kShift, PlannerType::kGeometric,
-                                                   PlannerType::kClothoid};
+  static const std::vector<PlannerType> kAvailable{PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid,
+                                                   PlannerType::kFreespace};
   return kAvailable;
 }
 
@@ -80,6 +81,8 @@ std::unique_ptr<PullOutPlanner> make_planner(PlannerType type) {
       return std::make_unique<GeometricPullOut>();
     case PlannerType::kClothoid:
       return std::make_unique<ClothoidPullOut>();
+    case PlannerType::kFreespace:
+      return std::make_unique<FreespacePullOut>();
     default:
       return nullptr;
   }
@@ -160,13 +163,42 @@ StartPlanner::StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameter
     : vehicle_(vehicle), parameters_(std::move(parameters)), limits_(limits), map_(std::move(map)) {}
 
 std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) const {
-  auto issues = validate_request_structure(request, limits_, available_planners(), map_ != nullptr);
-  if (!issues.empty()) return issues;
+  auto issues =
+      validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
+  if (!issues.empty() || (request.lanes.empty() && request.route_lanelet_ids.empty())) return issues;
   const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_);
   if (!lanes.issues.empty()) return lanes.issues;
   const LaneWorld world(*lanes.lanes);
   if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) issues.push_back(*issue);
   return issues;
+}
+
+bool StartPlanner::grid_only_allowed() const { return parameters_.freespace_planner.enable_freespace_planner; }
+
+PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const Deadline& deadline) const {
+  PlanningResult result;
+  const FreespaceParameters& p = parameters_.freespace_planner;
+  std::vector<Polygon> obstacles;
+  for (const Object& o : request.objects) {
+    if (std::abs(o.velocity_mps) >= parameters_.th_moving_object_velocity) continue;
+    if (!parameters_.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
+    obstacles.push_back(object_polygon(o));
+  }
+  const Costmap costmap = freespace_costmap(p, &*request.occupancy_grid, nullptr, obstacles, request.ego_pose, 0.0);
+  FreespaceGoalResult r = plan_freespace_to_goal(costmap, vehicle_, p, request.ego_pose, request.goal_pose, deadline);
+  const double margin = 0.5 * p.vehicle_shape_margin;
+  result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, to_string(r.status)});
+  if (r.status == HybridAStarResult::Status::kSuccess) {
+    result.outcome = PlanningResult::Outcome::kFound;
+    result.path = std::move(r.path);
+    return result;
+  }
+  result.timed_out = r.status == HybridAStarResult::Status::kTimeout;
+  result.outcome = PlanningResult::Outcome::kNoPath;
+  result.path = make_stop_path(request);
+  result.stop_reason = std::string("freespace to the goal: ") + to_string(r.status);
+  result.path.reasons.push_back(result.stop_reason);
+  return result;
 }
 
 PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline& deadline) const {
@@ -179,9 +211,15 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     r.path.stamp_ns = request.stamp_ns;
   };
 
-  result.issues = validate_request_structure(request, limits_, available_planners(), map_ != nullptr);
+  result.issues =
+      validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
   if (!result.issues.empty()) {
     result.outcome = PlanningResult::Outcome::kRejected;
+    finish(result);
+    return result;
+  }
+  if (request.lanes.empty() && request.route_lanelet_ids.empty()) {  // validation allowed it: a grid and freespace
+    result = plan_grid_only(request, deadline);
     finish(result);
     return result;
   }
@@ -215,10 +253,12 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   // All of them are considered, wherever they stand (Autoware keeps only those overlapping the
   // pull-out lanes, which misses a car standing half on the kerb next to the path).
   std::vector<Obstacle> obstacles;
+  std::vector<Polygon> obstacle_polygons;
   for (const Object& o : request.objects) {
     if (std::abs(o.velocity_mps) >= params.th_moving_object_velocity) continue;
     if (!params.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
     obstacles.push_back({o.id, object_polygon(o)});
+    obstacle_polygons.push_back(obstacles.back().polygon);
   }
   const ObjectChecker checker(vehicle_footprint(vehicle_), std::move(obstacles));
   // The lanes the vehicle stands in: the shoulder chain when it is on a shoulder, else the road.
@@ -240,7 +280,17 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   }
   double horizon = 0.0;
   for (double m : params.collision_check_margins) horizon = std::max(horizon, m);
-  const PlanningContext context{world, road, *pull_out, checker, vehicle_, params, request.goal_pose, horizon};
+  const PlanningContext context{world,
+                                road,
+                                *pull_out,
+                                checker,
+                                vehicle_,
+                                params,
+                                request.goal_pose,
+                                horizon,
+                                request.ego_pose,
+                                request.occupancy_grid ? &*request.occupancy_grid : nullptr,
+                                &obstacle_polygons};
 
   std::vector<std::unique_ptr<PullOutPlanner>> planners;
   for (PlannerType t : params.search_priority) {
@@ -264,6 +314,17 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     }
   }
 
+  const auto accept = [&](const PathCandidate& chosen, PlannerType type) {
+    result.outcome = PlanningResult::Outcome::kFound;
+    result.path = chosen.build();
+    result.path.found = true;
+    result.path.planner_type = type;
+    // The vehicle moves towards the centerline: right when it starts left of it.
+    result.path.turn_signal = result.path.shift_length_m > 0.0   ? TurnSignal::kRight
+                              : result.path.shift_length_m < 0.0 ? TurnSignal::kLeft
+                                                                 : TurnSignal::kNone;
+  };
+
   // Each (start, planner) pair is planned once, on first use; the margin ladder only re-reads
   // the candidates' clearances.
   std::vector<std::optional<PlannerCandidates>> planned(starts.size() * planners.size());
@@ -280,14 +341,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
       const Selection sel = select_candidate(*slot, margin);
       result.evaluation_table.push_back({planners[pi]->type(), margin, start.backward_distance, sel.outcome});
       if (sel.chosen != nullptr) {
-        result.outcome = PlanningResult::Outcome::kFound;
-        result.path = sel.chosen->build();
-        result.path.found = true;
-        result.path.planner_type = planners[pi]->type();
-        // The vehicle moves towards the centerline: right when it starts left of it.
-        result.path.turn_signal = result.path.shift_length_m > 0.0   ? TurnSignal::kRight
-                                  : result.path.shift_length_m < 0.0 ? TurnSignal::kLeft
-                                                                     : TurnSignal::kNone;
+        accept(*sel.chosen, planners[pi]->type());
         if (start.backward_distance > 0.0) {
           // Reverse to the start candidate first. Pair: cruise at backward_velocity, reached
           // over half the segment (a = v^2 / L) so that the vehicle stops at its end.
@@ -302,6 +356,23 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
       }
     }
     if (result.timed_out) break;
+  }
+
+  // Nothing found: the freespace fallback (unless it was searched in the order already).
+  const bool freespace_listed = std::find(params.search_priority.begin(), params.search_priority.end(),
+                                          PlannerType::kFreespace) != params.search_priority.end();
+  if (params.freespace_planner.enable_freespace_planner && !freespace_listed && !result.timed_out) {
+    const PlannerCandidates fallback = FreespacePullOut().plan(context, request.ego_pose, deadline);
+    result.timed_out = fallback.timed_out;
+    // The costmap keeps the grown footprint off every object: the margin is half the growth.
+    const double margin = 0.5 * params.freespace_planner.vehicle_shape_margin;
+    const Selection sel = select_candidate(fallback, 1e-6);  // any clearance: no contact
+    result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, sel.outcome});
+    if (sel.chosen != nullptr) {
+      accept(*sel.chosen, PlannerType::kFreespace);
+      finish(result);
+      return result;
+    }
   }
 
   result.outcome = PlanningResult::Outcome::kNoPath;

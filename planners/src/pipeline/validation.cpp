@@ -134,7 +134,8 @@ void validate_object(Checker& c, const std::string& f, const Object& o, const Re
 }  // namespace
 
 std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, const RequestLimits& limits,
-                                                     const std::vector<PlannerType>& available, bool has_map) {
+                                                     const std::vector<PlannerType>& available, bool has_map,
+                                                     bool allow_grid_only) {
   std::vector<RequestIssue> issues;
   Checker c(limits, issues);
   if (r.vehicle_id.empty()) c.add("vehicle_id", "empty");
@@ -157,8 +158,9 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
     } else if (!r.lanes.empty()) {
       c.add("lanes", "give either inline lanes or route_lanelet_ids on the map, not both");
     }
-  } else if (r.lanes.empty()) {
-    c.add("lanes", "empty: send at least one lane of subtype road");
+  } else if (r.lanes.empty() && !(allow_grid_only && r.occupancy_grid)) {
+    c.add("lanes", allow_grid_only ? "empty: send at least one lane of subtype road, or an occupancy grid"
+                                   : "empty: send at least one lane of subtype road");
   }
   if (c.count("lanes", r.lanes.size(), limits.max_lanes, "lanes")) {
     std::unordered_set<std::int64_t> ids;

@@ -34,18 +34,74 @@ std::string join_lines(const std::string& file, const std::vector<std::string>& 
 // Autoware start_planner parameters that this version does not implement: a clearer message
 // than "unknown key" for users who bring Autoware's file along.
 const char* start_planner_hint(const std::string& key) {
-  static constexpr std::array<std::string_view, 6> kAutowareOnly{
+  static constexpr std::array<std::string_view, 5> kAutowareOnly{
       "th_distance_to_middle_of_the_road",
       "maximum_longitudinal_deviation",
       "minimum_shift_length",
       "turn_signal_on_centerline_start",
-      "freespace_planner",
       "debug",
   };
   if (std::find(kAutowareOnly.begin(), kAutowareOnly.end(), key) != kAutowareOnly.end()) {
     return "Autoware parameter not supported in this version";
   }
   return nullptr;
+}
+
+// Autoware freespace_planner keys this version does not implement (the A* is the only algorithm).
+const char* freespace_hint(const std::string& key) {
+  static constexpr std::array<std::string_view, 6> kAutowareOnly{
+      "freespace_planner_algorithm", "rrtstar",
+      "minimum_turning_radius",      "maximum_turning_radius",
+      "turning_radius_size",         "only_behind_solutions"};
+  if (std::find(kAutowareOnly.begin(), kAutowareOnly.end(), key) != kAutowareOnly.end()) {
+    return "Autoware parameter not supported in this version (hybrid A* only)";
+  }
+  return nullptr;
+}
+
+void read_freespace(MapReader& parent, FreespaceParameters& out) {
+  MapReader r(parent.get("freespace_planner"), parent.key_path("freespace_planner"), parent.problems());
+  if (!r.valid()) return;
+  r.read("enable_freespace_planner", out.enable_freespace_planner);
+  r.read("end_pose_search_start_distance", out.end_pose_search_start_distance);
+  r.read("end_pose_search_end_distance", out.end_pose_search_end_distance);
+  r.read("end_pose_search_interval", out.end_pose_search_interval);
+  r.read("velocity", out.velocity);
+  r.read("vehicle_shape_margin", out.vehicle_shape_margin);
+  r.read("time_limit", out.time_limit);
+  r.read("max_turning_ratio", out.max_turning_ratio);
+  r.read("turning_steps", out.turning_steps);
+  {
+    MapReader sc(r.get("search_configs"), r.key_path("search_configs"), r.problems());
+    if (sc.valid()) {
+      sc.read("theta_size", out.search_configs.theta_size);
+      sc.read("angle_goal_range", out.search_configs.angle_goal_range);
+      sc.read("lateral_goal_range", out.search_configs.lateral_goal_range);
+      sc.read("longitudinal_goal_range", out.search_configs.longitudinal_goal_range);
+      sc.read("curve_weight", out.search_configs.curve_weight);
+      sc.read("reverse_weight", out.search_configs.reverse_weight);
+      sc.read("direction_change_weight", out.search_configs.direction_change_weight);
+      sc.finish();
+    }
+  }
+  {
+    MapReader cc(r.get("costmap_configs"), r.key_path("costmap_configs"), r.problems());
+    if (cc.valid()) {
+      cc.read("obstacle_threshold", out.costmap_configs.obstacle_threshold);
+      cc.read("resolution", out.costmap_configs.resolution);
+      cc.finish();
+    }
+  }
+  {
+    MapReader a(r.get("astar"), r.key_path("astar"), r.problems());
+    if (a.valid()) {
+      a.read("use_back", out.astar.use_back);
+      a.read("distance_heuristic_weight", out.astar.distance_heuristic_weight);
+      a.read("expansion_distance", out.astar.expansion_distance);
+      a.finish(&freespace_hint);
+    }
+  }
+  r.finish(&freespace_hint);
 }
 
 std::string lower(std::string s) {
@@ -453,6 +509,7 @@ void apply_start_planner_parameters(const YAML::Node& node, const std::string& p
   r.read("clothoid_collision_check_distance_from_end", p.clothoid_collision_check_distance_from_end);
   r.read("check_clothoid_path_lane_departure", p.check_clothoid_path_lane_departure);
   read_safety_sections(r, p);
+  read_freespace(r, p.freespace_planner);
   r.finish(&start_planner_hint);
 }
 

@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "config/config_detail.hpp"
+#include "config/grid_file.hpp"
 #include "config/yaml_fields.hpp"
 #include "pullout/maps/osm_loader.hpp"
 #include "pullout/model/names.hpp"
@@ -270,8 +271,16 @@ Scenario load_scenario(const std::string& path, const Config& base) {
   if (root.has("lanes") && root.has("route")) {
     problems.push_back("lanes: give either inline lanes or a route (map: and route:), not both");
   }
-  if (!root.has("lanes") && !root.has("route")) {
-    problems.push_back("lanes: required (the inline lanes, or map: and route: for a Lanelet2 map)");
+  if (root.has("grid")) {
+    OccupancyGrid grid;
+    if (read_scenario_grid(root, std::filesystem::path(path).parent_path().string(), grid)) {
+      request.occupancy_grid = std::move(grid);
+    }
+  }
+  if (!root.has("lanes") && !root.has("route") && !root.has("grid")) {
+    problems.push_back(
+        "lanes: required (the inline lanes, map: and route: for a Lanelet2 map, or a grid for a pure freespace "
+        "problem)");
   }
 
   request.ego_pose = read_pose(root, "start", true);

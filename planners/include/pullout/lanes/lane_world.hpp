@@ -71,6 +71,9 @@ class LaneWorld {
   // corner is inside some lane and no footprint edge crosses the outer boundary of the union.
   bool footprint_inside(const std::array<Vec2, 4>& corners) const;
 
+  // The outline of the union of the lanes: pieces of lane edges not shared with a neighbour.
+  const std::vector<std::pair<Vec2, Vec2>>& outer_edges() const { return outer_edges_; }
+
  private:
   void build_topology();
   void build_index();

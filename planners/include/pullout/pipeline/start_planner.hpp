@@ -3,7 +3,10 @@
 //
 //   request -> validate -> world (lanes, static objects) -> for each margin in
 //   collision_check_margins: for each planner in search_priority: plan, check lane departure and
-//   static collision -> first success -> velocities -> PullOutPath.
+//   static collision -> first success -> velocities -> PullOutPath. Nothing found and
+//   freespace_planner.enable_freespace_planner: the freespace pull-out (hybrid A*) from the ego
+//   pose. A request with an occupancy grid and no lanes (allowed when the freespace planner is
+//   enabled) is a pure freespace problem: hybrid A* straight to the goal pose.
 //
 // Thread safety: StartPlanner is immutable after construction; plan() may be called concurrently
 // from several threads. Failure modes are values, never exceptions: an invalid request gives
@@ -66,6 +69,10 @@ class StartPlanner {
   const std::shared_ptr<const LaneletMap>& map() const { return map_; }
 
  private:
+  bool grid_only_allowed() const;
+  // A request with a grid and no lanes: hybrid A* straight to the goal pose.
+  PlanningResult plan_grid_only(const PullOutRequest& request, const Deadline& deadline) const;
+
   VehicleInfo vehicle_;
   StartPlannerParameters parameters_;
   RequestLimits limits_;

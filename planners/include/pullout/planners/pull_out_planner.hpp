@@ -32,6 +32,11 @@ struct PlanningContext {
   const StartPlannerParameters& parameters;
   Pose2 goal;
   double clearance_horizon{std::numeric_limits<double>::infinity()};  // largest margin of the ladder [m]
+  // For the freespace planner: the vehicle's current pose, the request's occupancy grid (null
+  // when none) and the static obstacles' polygons (map frame).
+  Pose2 ego;
+  const OccupancyGrid* occupancy_grid{nullptr};
+  const std::vector<Polygon>* obstacle_polygons{nullptr};
 };
 
 struct PathCandidate {

@@ -15,6 +15,14 @@
 //        predicted_paths: [{time_step: 1.0, confidence: 1.0, points: [[20, 3.5], [20, 3.5]]}]}
 //        # optional; each pose heads to the next point. Without one, the safety check assumes
 //        # constant velocity along the object's heading.
+//   grid:                                     # optional occupancy grid (freespace planner):
+//     map: lot.yaml                           #   a ROS map_server YAML beside its PGM image, or
+//     resolution: 0.2                         #   [m] obstacle shapes on an extent:
+//     origin: {x: 0, y: 0, yaw_deg: 0}
+//     size: [30, 30]                          #   [m] width, height
+//     obstacles: [{x: 5, y: 5, yaw_deg: 0, length: 4.5, width: 1.9}, {polygon: [[0, 0], [1, 0], [0, 1]]}]
+//                                             # with a grid, lanes may be omitted: a pure freespace
+//                                             # problem straight to the goal
 //   planner:                                  # any start_planner parameter, overriding the config
 //     search_priority: [shift]
 //   deadline_ms: 200                          # optional

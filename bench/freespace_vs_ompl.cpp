@@ -1,0 +1,315 @@
+// Freespace benchmark: our hybrid A* against OMPL's RRT* and BIT* on the same problems, in the
+// same run, with the same collision test and the same time budget.
+//
+//   build/bench/bench_freespace [--problems 24] [--budget-ms 2000] [--seed 5] [--heuristic-weight 1.5]
+//
+// Problems: parking lots 30-100 m across, 0.1 or 0.2 m cells, walls around, rows of
+// perpendicular bays with parked cars (each bay taken with probability 0.7), generated from a
+// fixed seed. The start is an empty bay entered nose-in; the goal is either the lot's exit
+// (in the aisle at the far corner) or another empty bay, reversed into.
+//
+// Peers: OMPL RRT* and BIT* over ompl::base::ReedsSheppStateSpace (the same turning radius as our
+// primitives), with OUR GridCollisionChecker as the state validity checker, motions checked
+// every 5 cm. Each stops at its first exact solution or at the budget (time to first solution,
+// like ours). Reported: success rate, median and p95 time to the first solution (successes),
+// mean path length, mean number of direction changes. OMPL is a benchmark-only dependency.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <ompl/base/ScopedState.h>
+#include <ompl/base/objectives/PathLengthOptimizationObjective.h>
+#include <ompl/base/spaces/ReedsSheppStateSpace.h>
+#include <ompl/geometric/PathGeometric.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/informedtrees/BITstar.h>
+#include <ompl/geometric/planners/rrt/RRTstar.h>
+#include <ompl/util/Console.h>
+
+#include "pullout/freespace/costmap.hpp"
+#include "pullout/freespace/grid_collision_checker.hpp"
+#include "pullout/freespace/hybrid_astar.hpp"
+#include "pullout/freespace/reeds_shepp.hpp"
+#include "pullout/vehicle/vehicle_info.hpp"
+
+namespace {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+using pullout::Pose2;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kBayWidth = 2.7;  // [m]
+constexpr double kBayDepth = 5.5;  // [m]
+constexpr double kAisle = 7.0;     // [m]
+constexpr double kWall = 0.4;      // [m]
+constexpr double kMargin = 0.1;    // [m] footprint growth on each side
+
+struct Problem {
+  std::string name;
+  double size{30.0};
+  double resolution{0.2};
+  pullout::Costmap costmap;
+  Pose2 start;
+  Pose2 goal;
+};
+
+pullout::Polygon box(double cx, double cy, double yaw, double length, double width) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  pullout::Polygon p;
+  for (const auto& [lx, ly] : {std::pair{0.5, 0.5}, {-0.5, 0.5}, {-0.5, -0.5}, {0.5, -0.5}}) {
+    const double x = lx * length, y = ly * width;
+    p.push_back({cx + c * x - s * y, cy + s * x + c * y});
+  }
+  return p;
+}
+
+// A bay: its centre and the direction its opening faces (+1: the aisle is above, -1: below).
+struct Bay {
+  double x{0.0};
+  double y_open{0.0};  // y of the bay's open side
+  int faces{1};
+};
+
+Problem make_problem(int index, std::mt19937& rng, const pullout::Footprint& fp) {
+  Problem p;
+  const double sizes[] = {30.0, 50.0, 75.0, 100.0};
+  p.size = sizes[index % 4];
+  p.resolution = (index / 4) % 2 == 0 ? 0.2 : 0.1;
+  const int cells = static_cast<int>(std::round(p.size / p.resolution));
+  std::vector<pullout::Polygon> obstacles{box(p.size / 2, kWall / 2, 0, p.size, kWall),
+                                          box(p.size / 2, p.size - kWall / 2, 0, p.size, kWall),
+                                          box(kWall / 2, p.size / 2, 0, kWall, p.size)};
+  // The east wall, with the exit (8 m) at its top end.
+  obstacles.push_back(box(p.size - kWall / 2, (p.size - 8.0) / 2, 0, kWall, p.size - 8.0));
+  // Rows of bays: a single row along the south wall, then double rows, each followed by an aisle.
+  std::vector<Bay> bays;
+  double y = kWall;
+  bool single = true;
+  while (true) {
+    const double depth = single ? kBayDepth : 2 * kBayDepth;
+    if (y + depth + kAisle > p.size - kWall - 1e-9) break;
+    for (double x = 7.0; x + kBayWidth <= p.size - 7.0; x += kBayWidth) {
+      if (single) {
+        bays.push_back({x + kBayWidth / 2, y + kBayDepth, 1});
+      } else {
+        bays.push_back({x + kBayWidth / 2, y, -1});
+        bays.push_back({x + kBayWidth / 2, y + 2 * kBayDepth, 1});
+      }
+    }
+    y += depth + kAisle;
+    single = false;
+  }
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  // Two bays are kept free whatever the draw (the start's and one more).
+  std::uniform_int_distribution<std::size_t> pick(0, bays.size() - 1);
+  const std::size_t keep_a = pick(rng);
+  std::size_t keep_b = pick(rng);
+  while (keep_b == keep_a) keep_b = pick(rng);
+  std::vector<std::size_t> empty;
+  for (std::size_t i = 0; i < bays.size(); ++i) {
+    const Bay& b = bays[i];
+    if (i != keep_a && i != keep_b && u(rng) < 0.7) {
+      const double cy = b.y_open - b.faces * (kBayDepth / 2);
+      obstacles.push_back(box(b.x + (u(rng) - 0.5) * 0.3, cy, kPi / 2 + (u(rng) - 0.5) * 0.1, 4.6, 1.9));
+    } else {
+      empty.push_back(i);
+    }
+  }
+  std::vector<std::uint8_t> occ(static_cast<std::size_t>(cells) * cells, 0);
+  p.costmap = pullout::Costmap({0, 0, 0}, p.resolution, cells, cells, std::move(occ));
+  p.costmap.add_obstacles(obstacles);
+  // Parked in a bay: rear bumper 0.3 m inside the opening. Nose-in faces away from the aisle.
+  const auto parked = [&](const Bay& b, bool nose_in) {
+    const double inward = -b.faces;  // +y or -y into the bay
+    const double yaw = inward > 0 ? kPi / 2 : -kPi / 2;
+    if (nose_in) return Pose2{b.x, b.y_open + inward * (0.3 + fp.rear), yaw};
+    return Pose2{b.x, b.y_open + inward * (0.3 + fp.front), std::remainder(yaw + kPi, 2.0 * kPi)};
+  };
+  std::shuffle(empty.begin(), empty.end(), rng);
+  p.start = parked(bays[empty[0]], true);
+  if (index % 2 == 0) {
+    p.goal = {p.size - 4.0, p.size - kWall - kAisle / 2, 0.0};  // at the exit, heading out
+    p.name = "exit";
+  } else {
+    // The empty bay farthest from the start, reversed into.
+    std::size_t far = empty[1];
+    for (std::size_t k = 1; k < empty.size(); ++k) {
+      const double d = std::hypot(bays[empty[k]].x - bays[empty[0]].x, bays[empty[k]].y_open - bays[empty[0]].y_open);
+      if (d > std::hypot(bays[far].x - bays[empty[0]].x, bays[far].y_open - bays[empty[0]].y_open)) far = empty[k];
+    }
+    p.goal = parked(bays[far], false);
+    p.name = "bay";
+  }
+  p.name = std::to_string(static_cast<int>(p.size)) + "m/" + (p.resolution < 0.15 ? "0.1" : "0.2") + "/" + p.name;
+  return p;
+}
+
+struct Run {
+  bool success{false};
+  double time_ms{0.0};
+  double length{0.0};
+  int direction_changes{0};
+};
+
+Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
+             double heuristic_weight) {
+  pullout::HybridAStarConfig config;
+  config.turning_radius = radius;
+  config.distance_heuristic_weight = heuristic_weight;
+  const pullout::HybridAStar planner(checker, config);
+  const auto t0 = std::chrono::steady_clock::now();
+  const pullout::HybridAStarResult r = planner.plan(p.start, p.goal, pullout::Deadline::after_ms(budget_ms));
+  Run run;
+  run.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  run.success = r.status == pullout::HybridAStarResult::Status::kSuccess;
+  run.length = r.length;
+  for (std::size_t i = 1; i < r.waypoints.size(); ++i) {
+    run.direction_changes += r.waypoints[i].direction != r.waypoints[i - 1].direction ? 1 : 0;
+  }
+  return run;
+}
+
+Run run_ompl(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
+             bool bit_star) {
+  auto space = std::make_shared<ob::ReedsSheppStateSpace>(radius);
+  ob::RealVectorBounds bounds(2);
+  bounds.setLow(0.0);
+  bounds.setHigh(p.size);
+  space->setBounds(bounds);
+  og::SimpleSetup ss(space);
+  ss.setStateValidityChecker([&checker](const ob::State* s) {
+    const auto* st = s->as<ob::SE2StateSpace::StateType>();
+    return !checker.collides({st->getX(), st->getY(), st->getYaw()});
+  });
+  ss.getSpaceInformation()->setStateValidityCheckingResolution(0.05 / space->getMaximumExtent());
+  ob::ScopedState<> start(space), goal(space);
+  start[0] = p.start.x;
+  start[1] = p.start.y;
+  start[2] = p.start.yaw;
+  goal[0] = p.goal.x;
+  goal[1] = p.goal.y;
+  goal[2] = p.goal.yaw;
+  ss.setStartAndGoalStates(start, goal, 0.05);
+  // An objective that any solution satisfies: RRT* and BIT* return their first solution (else
+  // they would refine it until the budget runs out).
+  auto objective = std::make_shared<ob::PathLengthOptimizationObjective>(ss.getSpaceInformation());
+  objective->setCostThreshold(ob::Cost(std::numeric_limits<double>::infinity()));
+  ss.setOptimizationObjective(objective);
+  if (bit_star) {
+    ss.setPlanner(std::make_shared<og::BITstar>(ss.getSpaceInformation()));
+  } else {
+    ss.setPlanner(std::make_shared<og::RRTstar>(ss.getSpaceInformation()));
+  }
+  ss.setup();
+  const auto t0 = std::chrono::steady_clock::now();
+  const ob::PlannerTerminationCondition ptc =
+      ob::plannerOrTerminationCondition(ob::timedPlannerTerminationCondition(budget_ms / 1000.0),
+                                        ob::exactSolnPlannerTerminationCondition(ss.getProblemDefinition()));
+  const ob::PlannerStatus status = ss.solve(ptc);
+  Run run;
+  run.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  run.success = status == ob::PlannerStatus::EXACT_SOLUTION;
+  if (!run.success) return run;
+  const og::PathGeometric& path = ss.getSolutionPath();
+  run.length = path.length();
+  // Direction changes: the Reeds-Shepp segments between consecutive states, in order.
+  const pullout::ReedsShepp rs(radius);
+  int last = 0;
+  for (std::size_t i = 1; i < path.getStateCount(); ++i) {
+    const auto* a = path.getState(i - 1)->as<ob::SE2StateSpace::StateType>();
+    const auto* b = path.getState(i)->as<ob::SE2StateSpace::StateType>();
+    const pullout::ReedsSheppPath piece =
+        rs.shortest({a->getX(), a->getY(), a->getYaw()}, {b->getX(), b->getY(), b->getYaw()});
+    for (int k = 0; k < piece.count; ++k) {
+      const double l = piece.segments[static_cast<std::size_t>(k)].length;
+      if (std::abs(l) < 1e-9) continue;
+      const int dir = l > 0 ? 1 : -1;
+      if (last != 0 && dir != last) ++run.direction_changes;
+      last = dir;
+    }
+  }
+  return run;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const double pos = q * (v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const auto hi = std::min(v.size() - 1, lo + 1);
+  return v[lo] + (pos - lo) * (v[hi] - v[lo]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int problems = 24;
+  double budget_ms = 2000.0;
+  unsigned seed = 5;
+  double heuristic_weight = 1.5;  // astar.distance_heuristic_weight
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (std::strcmp(argv[i], "--problems") == 0) problems = std::atoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--budget-ms") == 0) budget_ms = std::atof(argv[i + 1]);
+    if (std::strcmp(argv[i], "--seed") == 0) seed = static_cast<unsigned>(std::atoi(argv[i + 1]));
+    if (std::strcmp(argv[i], "--heuristic-weight") == 0) heuristic_weight = std::atof(argv[i + 1]);
+  }
+  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+  const pullout::VehicleInfo vehicle;
+  const double radius = vehicle.wheel_base_m / std::tan(vehicle.max_steer_angle_rad * 0.7);  // max_turning_ratio 0.7
+  const pullout::Footprint fp = pullout::vehicle_footprint(vehicle, kMargin);
+  std::mt19937 rng(seed);
+  const char* names[3] = {"hybrid A* (pullout)", "OMPL RRT*", "OMPL BIT*"};
+  std::vector<Run> runs[3];
+  std::vector<double> small_ours;  // 30 m at 0.2 m
+  std::printf("%-18s %28s %28s %28s\n", "problem", names[0], names[1], names[2]);
+  for (int i = 0; i < problems; ++i) {
+    const Problem p = make_problem(i, rng, fp);
+    const pullout::GridCollisionChecker checker(p.costmap, fp);
+    if (checker.collides(p.start) || checker.collides(p.goal)) {
+      std::printf("%-18s invalid start or goal (generator bug)\n", p.name.c_str());
+      return 1;
+    }
+    const Run r[3] = {run_ours(p, checker, radius, budget_ms, heuristic_weight),
+                      run_ompl(p, checker, radius, budget_ms, false), run_ompl(p, checker, radius, budget_ms, true)};
+    std::printf("%-18s", p.name.c_str());
+    for (int k = 0; k < 3; ++k) {
+      runs[k].push_back(r[k]);
+      if (r[k].success) {
+        std::printf("   %8.1f ms %6.1f m %2d cusps", r[k].time_ms, r[k].length, r[k].direction_changes);
+      } else {
+        std::printf("   %8.1f ms     (no solution)", r[k].time_ms);
+      }
+    }
+    std::printf("\n");
+    if (p.size == 30.0 && p.resolution > 0.15 && r[0].success) small_ours.push_back(r[0].time_ms);
+  }
+  std::printf(
+      "\n| planner | success | median time to first solution [ms] | p95 [ms] | mean length [m] | mean direction "
+      "changes |\n");
+  std::printf("|---|---|---|---|---|---|\n");
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> t;
+    double len = 0.0, changes = 0.0;
+    for (const Run& r : runs[k]) {
+      if (!r.success) continue;
+      t.push_back(r.time_ms);
+      len += r.length;
+      changes += r.direction_changes;
+    }
+    const double n = std::max<double>(1.0, static_cast<double>(t.size()));
+    std::printf("| %s | %zu/%zu | %.1f | %.1f | %.1f | %.2f |\n", names[k], t.size(), runs[k].size(),
+                percentile(t, 0.5), percentile(t, 0.95), len / n, changes / n);
+  }
+  std::printf("\nhybrid A* median on 30 m x 30 m at 0.2 m: %.1f ms (%zu problems)\n", percentile(small_ours, 0.5),
+              small_ours.size());
+  return 0;
+}

@@ -1,0 +1,101 @@
+// The costmap of the freespace planner: a binary occupancy grid with what the search needs
+// precomputed (row prefix sums for exact footprint tests, a Euclidean distance transform for cheap
+// clearance bounds).
+//
+// Frames: the grid frame G has its origin at the outer corner of cell (0, 0) and its axes along
+// the rows (+x, increasing column) and columns (+y, increasing row); X_MG = `origin` is its pose in
+// the map frame M (ROS nav_msgs/OccupancyGrid convention, row-major from the origin). Cell (i, j)
+// (column i, row j) is the closed square [i, i+1] x [j, j+1] in cell units (x resolution in
+// metres). Everything outside the grid counts as occupied: the planner never leaves the map.
+//
+// Sources:
+//  - a request's occupancy grid (ROS values 0..100, -1 unknown): a cell is an obstacle when its
+//    value is unknown (< 0) or >= obstacle_threshold, as in Autoware's costmap_configs;
+//  - the drivable area (lane polygons) and static object footprints, rasterised conservatively: a
+//    cell is free only when it lies entirely inside the lanes and touches no object.
+//
+// The distance transform is exact for cell centres (Felzenszwalb & Huttenlocher, "Distance
+// Transforms of Sampled Functions", Theory of Computing 8, 2012).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "pullout/geometry/polygon.hpp"
+#include "pullout/model/types.hpp"
+
+namespace pullout {
+
+class Costmap {
+ public:
+  Costmap() = default;
+  // `occupied` is row-major (width x height), non-zero = obstacle. resolution > 0 [m].
+  Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied);
+
+  // From a ROS occupancy grid: unknown (< 0) or >= obstacle_threshold is an obstacle.
+  static Costmap from_occupancy_grid(const OccupancyGrid& grid, int obstacle_threshold);
+  // An axis-aligned grid over `extent` (map frame) at `resolution`: free where a cell lies inside
+  // the union of `drivable` polygons (simple polygons, any orientation) and touches no `obstacles`
+  // polygon. `drivable_outline` lists the edges of the union's outline (edges shared by two lanes
+  // excluded); cells it touches are obstacles.
+  static Costmap from_polygons(const Aabb& extent, double resolution, const std::vector<Polygon>& drivable,
+                               const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
+                               const std::vector<Polygon>& obstacles);
+
+  // Marks every cell whose interior a polygon (map frame) meets as occupied (conservative;
+  // non-convex polygons are filled row by row between their extreme points; a segment marks the
+  // cells it passes through). Updates the precomputation.
+  void add_obstacles(const std::vector<Polygon>& polygons);
+
+  bool empty() const { return width_ == 0 || height_ == 0; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  double resolution() const { return resolution_; }
+  const Pose2& origin() const { return origin_; }
+  std::size_t occupied_count() const;
+
+  // Cell occupancy; outside the grid is occupied.
+  bool occupied(int ix, int iy) const {
+    return ix < 0 || iy < 0 || ix >= width_ || iy >= height_ || occupied_[index(ix, iy)] != 0;
+  }
+  // Point in the map frame -> grid frame in cell units.
+  Vec2 to_grid(const Vec2& p_M) const;
+  // Grid frame in cell units -> map frame.
+  Vec2 to_map(const Vec2& p_G) const;
+  // The cell containing a map point (may be outside the grid).
+  void cell_of(const Vec2& p_M, int& ix, int& iy) const;
+  bool inside(int ix, int iy) const { return ix >= 0 && iy >= 0 && ix < width_ && iy < height_; }
+
+  // Distance [m] from the centre of cell (ix, iy) to the centre of the nearest occupied cell
+  // (inside the grid; the grid border counts as occupied, one cell beyond the edge).
+  double centre_distance(int ix, int iy) const { return distance_[index(ix, iy)]; }
+  // A lower bound [m] of the distance from map point p to the nearest occupied cell (as a closed
+  // square); 0 outside the grid or on an occupied cell.
+  double clearance_lower_bound(const Vec2& p_M) const;
+
+  // Number of occupied cells in row iy between columns c0 and c1 (inclusive, clamped to the grid;
+  // columns outside the grid count as occupied).
+  int occupied_in_row(int iy, int c0, int c1) const;
+
+ private:
+  std::size_t index(int ix, int iy) const {
+    return static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(ix);
+  }
+  void precompute();
+
+  Pose2 origin_;
+  double resolution_{0.2};
+  double cos_{1.0};
+  double sin_{0.0};
+  int width_{0};
+  int height_{0};
+  std::vector<std::uint8_t> occupied_;
+  std::vector<std::int32_t> row_prefix_;  // (width + 1) per row: occupied cells left of column c
+  std::vector<float> distance_;           // [m] see centre_distance
+};
+
+// The column extent of a convex polygon (grid frame, cell units) within the horizontal strip
+// y in [y0, y1]: false when they do not meet. Exact (touching counts as meeting).
+bool strip_extent(const Vec2* vertices, std::size_t count, double y0, double y1, double& x_min, double& x_max);
+
+}  // namespace pullout

@@ -1,0 +1,249 @@
+#include "pullout/freespace/costmap.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pullout {
+
+namespace {
+
+constexpr double kSqrt2 = 1.41421356237309504880;
+
+// One dimension of the squared Euclidean distance transform of a sampled function (Felzenszwalb &
+// Huttenlocher 2012): d[q] = min_p (q - p)^2 + f[p]. Free samples carry a large finite value
+// (kFar) instead of infinity, which keeps the parabola intersections well defined. v, z are
+// scratch of sizes n and n + 1.
+constexpr double kFar = 1e30;
+
+void distance_transform_1d(const double* f, int n, double* d, int* v, double* z) {
+  int k = 0;
+  v[0] = 0;
+  z[0] = -std::numeric_limits<double>::infinity();
+  z[1] = std::numeric_limits<double>::infinity();
+  for (int q = 1; q < n; ++q) {
+    double s = 0.0;
+    while (true) {
+      const int p = v[k];
+      s = ((f[q] + static_cast<double>(q) * q) - (f[p] + static_cast<double>(p) * p)) / (2.0 * (q - p));
+      if (s > z[k]) break;  // z[0] = -inf ends the loop at k = 0
+      --k;
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = std::numeric_limits<double>::infinity();
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[k + 1] < static_cast<double>(q)) ++k;
+    const double dq = static_cast<double>(q - v[k]);
+    d[q] = dq * dq + f[v[k]];
+  }
+}
+
+}  // namespace
+
+bool strip_extent(const Vec2* vertices, std::size_t count, double y0, double y1, double& x_min, double& x_max) {
+  x_min = std::numeric_limits<double>::infinity();
+  x_max = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < count; ++i) {
+    const Vec2& a = vertices[i];
+    if (a.y() >= y0 && a.y() <= y1) {
+      x_min = std::min(x_min, a.x());
+      x_max = std::max(x_max, a.x());
+    }
+    const Vec2& b = vertices[(i + 1) % count];
+    if (a.y() == b.y()) continue;
+    for (const double yl : {y0, y1}) {
+      if ((a.y() - yl) * (b.y() - yl) > 0.0) continue;
+      const double x = a.x() + (yl - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
+      x_min = std::min(x_min, x);
+      x_max = std::max(x_max, x);
+    }
+  }
+  return x_min <= x_max;
+}
+
+Costmap::Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied)
+    : origin_(origin),
+      resolution_(resolution),
+      cos_(std::cos(origin.yaw)),
+      sin_(std::sin(origin.yaw)),
+      width_(std::max(0, width)),
+      height_(std::max(0, height)),
+      occupied_(std::move(occupied)) {
+  occupied_.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), 0);
+  precompute();
+}
+
+Costmap Costmap::from_occupancy_grid(const OccupancyGrid& grid, int obstacle_threshold) {
+  std::vector<std::uint8_t> occ(grid.data.size());
+  for (std::size_t i = 0; i < grid.data.size(); ++i) {
+    occ[i] = (grid.data[i] < 0 || grid.data[i] >= obstacle_threshold) ? 1 : 0;
+  }
+  return Costmap(grid.origin, grid.resolution_m, static_cast<int>(grid.width), static_cast<int>(grid.height),
+                 std::move(occ));
+}
+
+Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std::vector<Polygon>& drivable,
+                               const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
+                               const std::vector<Polygon>& obstacles) {
+  const int w = std::max(1, static_cast<int>(std::ceil((extent.max.x() - extent.min.x()) / resolution)));
+  const int h = std::max(1, static_cast<int>(std::ceil((extent.max.y() - extent.min.y()) / resolution)));
+  const Pose2 origin{extent.min.x(), extent.min.y(), 0.0};
+  std::vector<std::uint8_t> occ(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 1);
+
+  // Cells whose centre lies inside some drivable polygon (even-odd rule per polygon, the union
+  // over polygons), found by one crossing list per row at the cell centres' height.
+  std::vector<std::vector<double>> crossings(static_cast<std::size_t>(h));
+  for (const Polygon& poly : drivable) {
+    for (auto& row : crossings) row.clear();
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const Vec2 a = (poly[i] - extent.min) / resolution;
+      const Vec2 b = (poly[(i + 1) % poly.size()] - extent.min) / resolution;
+      if (a.y() == b.y()) continue;
+      const double lo = std::min(a.y(), b.y());
+      const double hi = std::max(a.y(), b.y());
+      // Rows j whose centre j + 0.5 is in [lo, hi): half-open, so a vertex is counted once.
+      const int j0 = std::max(0, static_cast<int>(std::ceil(lo - 0.5)));
+      const int j1 = std::min(h - 1, static_cast<int>(std::ceil(hi - 0.5)) - 1);
+      for (int j = j0; j <= j1; ++j) {
+        const double y = j + 0.5;
+        crossings[static_cast<std::size_t>(j)].push_back(a.x() + (y - a.y()) / (b.y() - a.y()) * (b.x() - a.x()));
+      }
+    }
+    for (int j = 0; j < h; ++j) {
+      auto& xs = crossings[static_cast<std::size_t>(j)];
+      std::sort(xs.begin(), xs.end());
+      for (std::size_t k = 0; k + 1 < xs.size(); k += 2) {
+        // Columns whose centre i + 0.5 lies in [xs[k], xs[k+1]].
+        const int i0 = std::max(0, static_cast<int>(std::ceil(xs[k] - 0.5)));
+        const int i1 = std::min(w - 1, static_cast<int>(std::floor(xs[k + 1] - 0.5)));
+        for (int i = i0; i <= i1; ++i) occ[static_cast<std::size_t>(j) * w + i] = 0;
+      }
+    }
+  }
+  Costmap map(origin, resolution, w, h, std::move(occ));
+  // The outline cuts through the cells it touches: those are not entirely drivable.
+  std::vector<Polygon> blocked;
+  blocked.reserve(drivable_outline.size() + obstacles.size());
+  for (const auto& [a, b] : drivable_outline) blocked.push_back({a, b});
+  blocked.insert(blocked.end(), obstacles.begin(), obstacles.end());
+  map.add_obstacles(blocked);
+  return map;
+}
+
+void Costmap::add_obstacles(const std::vector<Polygon>& polygons) {
+  std::vector<Vec2> g;
+  for (const Polygon& poly : polygons) {
+    if (poly.empty()) continue;
+    g.clear();
+    double y_lo = std::numeric_limits<double>::infinity();
+    double y_hi = -y_lo;
+    for (const Vec2& p : poly) {
+      g.push_back(to_grid(p));
+      y_lo = std::min(y_lo, g.back().y());
+      y_hi = std::max(y_hi, g.back().y());
+    }
+    // A cell is marked when the polygon meets its interior: a polygon that ends exactly on a
+    // cell boundary (a wall 0.4 m thick on 0.2 m cells) does not mark the next cell.
+    constexpr double kInterior = 1e-9;  // [cells]
+    const int j0 = std::max(0, static_cast<int>(std::floor(y_lo + kInterior)));
+    const int j1 = std::min(height_ - 1, static_cast<int>(std::floor(y_hi - kInterior)));
+    for (int j = j0; j <= j1; ++j) {
+      double x0 = 0.0;
+      double x1 = 0.0;
+      if (!strip_extent(g.data(), g.size(), j + kInterior, j + 1.0 - kInterior, x0, x1)) continue;
+      const int i0 = std::max(0, static_cast<int>(std::floor(x0 + kInterior)));
+      const int i1 = std::min(width_ - 1, static_cast<int>(std::floor(x1 - kInterior)));
+      for (int i = i0; i <= i1; ++i) occupied_[index(i, j)] = 1;
+    }
+  }
+  precompute();
+}
+
+std::size_t Costmap::occupied_count() const {
+  return static_cast<std::size_t>(std::count_if(occupied_.begin(), occupied_.end(), [](auto v) { return v != 0; }));
+}
+
+Vec2 Costmap::to_grid(const Vec2& p) const {
+  const double dx = p.x() - origin_.x;
+  const double dy = p.y() - origin_.y;
+  return {(cos_ * dx + sin_ * dy) / resolution_, (-sin_ * dx + cos_ * dy) / resolution_};
+}
+
+Vec2 Costmap::to_map(const Vec2& g) const {
+  const double x = g.x() * resolution_;
+  const double y = g.y() * resolution_;
+  return {origin_.x + cos_ * x - sin_ * y, origin_.y + sin_ * x + cos_ * y};
+}
+
+void Costmap::cell_of(const Vec2& p_M, int& ix, int& iy) const {
+  const Vec2 g = to_grid(p_M);
+  // Clamped before the conversion so that far-away points cannot overflow int.
+  ix = static_cast<int>(std::floor(std::clamp(g.x(), -2.0, width_ + 2.0)));
+  iy = static_cast<int>(std::floor(std::clamp(g.y(), -2.0, height_ + 2.0)));
+}
+
+double Costmap::clearance_lower_bound(const Vec2& p_M) const {
+  int ix = 0;
+  int iy = 0;
+  cell_of(p_M, ix, iy);
+  if (occupied(ix, iy)) return 0.0;
+  // p is within res/sqrt2 of its cell centre, and an occupied square within res/sqrt2 of its own.
+  return std::max(0.0, static_cast<double>(distance_[index(ix, iy)]) - kSqrt2 * resolution_);
+}
+
+int Costmap::occupied_in_row(int iy, int c0, int c1) const {
+  if (iy < 0 || iy >= height_) return c1 - c0 + 1;
+  int outside = 0;
+  if (c0 < 0) {
+    outside += -c0;
+    c0 = 0;
+  }
+  if (c1 >= width_) {
+    outside += c1 - width_ + 1;
+    c1 = width_ - 1;
+  }
+  if (c1 < c0) return outside;
+  const std::int32_t* row = row_prefix_.data() + static_cast<std::size_t>(iy) * (width_ + 1);
+  return outside + row[c1 + 1] - row[c0];
+}
+
+void Costmap::precompute() {
+  row_prefix_.assign(static_cast<std::size_t>(width_ + 1) * static_cast<std::size_t>(height_), 0);
+  for (int j = 0; j < height_; ++j) {
+    std::int32_t* row = row_prefix_.data() + static_cast<std::size_t>(j) * (width_ + 1);
+    for (int i = 0; i < width_; ++i) row[i + 1] = row[i] + (occupied_[index(i, j)] != 0 ? 1 : 0);
+  }
+
+  // Squared distance transform on the grid padded by one occupied cell on every side.
+  const int pw = width_ + 2;
+  const int ph = height_ + 2;
+  std::vector<double> f(static_cast<std::size_t>(pw) * ph, 0.0);
+  for (int j = 0; j < height_; ++j) {
+    for (int i = 0; i < width_; ++i) {
+      f[static_cast<std::size_t>(j + 1) * pw + (i + 1)] = occupied_[index(i, j)] != 0 ? 0.0 : kFar;
+    }
+  }
+  const int n = std::max(pw, ph);
+  std::vector<double> in(n);
+  std::vector<double> out(n);
+  std::vector<double> z(n + 1);
+  std::vector<int> v(n);
+  for (int i = 0; i < pw; ++i) {  // columns
+    for (int j = 0; j < ph; ++j) in[j] = f[static_cast<std::size_t>(j) * pw + i];
+    distance_transform_1d(in.data(), ph, out.data(), v.data(), z.data());
+    for (int j = 0; j < ph; ++j) f[static_cast<std::size_t>(j) * pw + i] = out[j];
+  }
+  distance_.assign(static_cast<std::size_t>(width_) * height_, 0.0F);
+  for (int j = 1; j <= height_; ++j) {  // rows (the padding rows are not needed any more)
+    distance_transform_1d(&f[static_cast<std::size_t>(j) * pw], pw, out.data(), v.data(), z.data());
+    for (int i = 1; i <= width_; ++i) {
+      distance_[index(i - 1, j - 1)] = static_cast<float>(std::sqrt(out[i]) * resolution_);
+    }
+  }
+}
+
+}  // namespace pullout

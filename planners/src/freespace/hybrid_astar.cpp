@@ -1,0 +1,298 @@
+#include "pullout/freespace/hybrid_astar.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+#include "pullout/freespace/reeds_shepp.hpp"
+#include "search_support.hpp"
+
+namespace pullout {
+
+namespace fd = freespace_detail;
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
+constexpr std::size_t kDeadlineCheckInterval = 16;  // expansions between clock reads
+constexpr int kShotCandidates = 3;                  // Reeds-Shepp words tried per shot, cheapest first
+constexpr double kShotDistancePerInterval = 4.0;    // [m] heuristic distance per expansion between shots
+constexpr double kReedsSheppRange = 4.0;            // [turning radii] see heuristic()
+constexpr double kCoarseSpacing = 1.0;              // [m] first-pass sample spacing of a shot
+
+double wrap(double a) {
+  a = std::fmod(a + kTwoPi / 2.0, kTwoPi);
+  if (a < 0.0) a += kTwoPi;
+  return a - kTwoPi / 2.0;
+}
+
+struct Node {
+  Pose2 pose;
+  double g{0.0};
+  std::int32_t parent{-1};
+  std::int8_t steer{0};      // steer index of the primitive that led here
+  std::int8_t direction{0};  // +1 / -1 of that primitive, 0 at the start
+  bool closed{false};
+};
+
+// How the last piece (goal region or shot) was reached.
+struct Finish {
+  std::int32_t node{-1};
+  bool shot{false};
+  ReedsSheppPath path;
+};
+
+class Search {
+ public:
+  Search(const GridCollisionChecker& checker, const HybridAStarConfig& config, const Pose2& start, const Pose2& goal)
+      : checker_(checker),
+        costmap_(checker.costmap()),
+        config_(config),
+        start_(start),
+        goal_(goal),
+        rs_(config.turning_radius),
+        weights_{config.curve_weight, config.reverse_weight, config.direction_change_weight},
+        heuristic_(costmap_, 0.5 * checker.footprint().width(), xy_resolution(), goal) {}
+
+  HybridAStarResult run(const Deadline& deadline) {
+    HybridAStarResult result;
+    if (checker_.collides(start_)) {
+      result.status = HybridAStarResult::Status::kStartOccupied;
+      return result;
+    }
+    if (checker_.collides(goal_)) {
+      result.status = HybridAStarResult::Status::kGoalOccupied;
+      return result;
+    }
+    add_node({start_, 0.0, -1, 0, 0, false});
+    Finish finish;
+    std::size_t since_shot = 0;
+    while (!open_.empty()) {
+      if (result.expansions % kDeadlineCheckInterval == 0 && deadline.expired()) {
+        result.status = HybridAStarResult::Status::kTimeout;
+        break;
+      }
+      const auto [f, index] = open_.top();
+      open_.pop();
+      if (nodes_[static_cast<std::size_t>(index)].closed) continue;
+      nodes_[static_cast<std::size_t>(index)].closed = true;
+      ++result.expansions;
+      const Node node = nodes_[static_cast<std::size_t>(index)];
+      if (in_goal_region(node.pose)) {
+        finish.node = index;
+        break;
+      }
+      // Analytic expansion: every expansion near the goal, less often far from it.
+      const double h2d = heuristic_.distance(node.pose);
+      const auto interval = static_cast<std::size_t>(std::max(1.0, h2d / kShotDistancePerInterval));
+      if (++since_shot >= interval) {
+        since_shot = 0;
+        if (shoot(node, finish.path)) {
+          finish.node = index;
+          finish.shot = true;
+          break;
+        }
+      }
+      if (nodes_.size() >= config_.max_nodes) break;
+      expand(index);
+    }
+    result.nodes = nodes_.size();
+    if (finish.node < 0) {
+      if (result.status != HybridAStarResult::Status::kTimeout) result.status = HybridAStarResult::Status::kNoPath;
+      return result;
+    }
+    result.status = HybridAStarResult::Status::kSuccess;
+    result.reached_exact_goal = finish.shot;
+    build_waypoints(finish, result);
+    return result;
+  }
+
+ private:
+  double xy_resolution() const {
+    return config_.xy_resolution > 0.0 ? config_.xy_resolution : config_.primitive_length / std::sqrt(2.0);
+  }
+
+  std::uint64_t key(const Pose2& p) const {
+    const Vec2 g = costmap_.to_grid({p.x, p.y}) * (costmap_.resolution() / xy_resolution());
+    const auto ix = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(g.x())) + (1 << 20));
+    const auto iy = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(g.y())) + (1 << 20));
+    const double bin = kTwoPi / config_.theta_size;
+    auto it = static_cast<std::int64_t>(std::floor((wrap(p.yaw) + kTwoPi / 2.0) / bin));
+    it = ((it % config_.theta_size) + config_.theta_size) % config_.theta_size;
+    return (ix << 42) | (iy << 20) | static_cast<std::uint64_t>(it);
+  }
+
+  // Plain Reeds-Shepp length: the cost weights make the true cost larger still, but a weighted
+  // Reeds-Shepp bound steers the search into obstacles the 2D distance goes around (measured:
+  // 20x more expansions around a wall).
+  // Far from the goal the 2D distance dominates (a Reeds-Shepp path exceeds the straight line by
+  // at most a few turning radii, and obstacles lengthen the 2D distance): the Reeds-Shepp term,
+  // the costliest part of an expansion, is only computed within kReedsSheppRange radii.
+  double heuristic(const Pose2& p) const {
+    const double h2d = heuristic_.distance(p);
+    if (!std::isfinite(h2d)) return h2d;
+    if (h2d > kReedsSheppRange * config_.turning_radius) return config_.distance_heuristic_weight * h2d;
+    return config_.distance_heuristic_weight * std::max(h2d, rs_.distance(p, goal_));
+  }
+
+  bool in_goal_region(const Pose2& p) const {
+    const double c = std::cos(goal_.yaw);
+    const double s = std::sin(goal_.yaw);
+    const double dx = p.x - goal_.x;
+    const double dy = p.y - goal_.y;
+    const double lon = c * dx + s * dy;
+    const double lat = -s * dx + c * dy;
+    return std::abs(lon) <= 0.5 * config_.longitudinal_goal_range &&
+           std::abs(lat) <= 0.5 * config_.lateral_goal_range &&
+           std::abs(wrap(p.yaw - goal_.yaw)) <= 0.5 * config_.angle_goal_range;
+  }
+
+  // Adds a node unless its lattice cell holds a cheaper one; pushes it on the open list.
+  void add_node(const Node& node) {
+    std::int32_t* slot = table_.find_or_insert(key(node.pose));
+    if (*slot >= 0) {
+      Node& existing = nodes_[static_cast<std::size_t>(*slot)];
+      if (existing.closed || existing.g <= node.g) return;
+      existing.closed = true;  // superseded: its heap entry is skipped when popped
+    }
+    const double h = heuristic(node.pose);
+    if (!std::isfinite(h)) return;
+    *slot = static_cast<std::int32_t>(nodes_.size());
+    nodes_.push_back(node);
+    open_.push({node.g + h, *slot});
+  }
+
+  void expand(std::int32_t index) {
+    const Node parent = nodes_[static_cast<std::size_t>(index)];
+    const std::uint64_t parent_key = key(parent.pose);
+    const int steps = config_.turning_steps;
+    for (const int direction : {1, -1}) {
+      if (direction < 0 && !config_.use_back) continue;
+      for (int steer = -steps; steer <= steps; ++steer) {
+        const double curvature = static_cast<double>(steer) / steps / config_.turning_radius;
+        const double distance = direction * config_.primitive_length;
+        const Pose2 child_pose = fd::drive(parent.pose, curvature, distance);
+        if (key(child_pose) == parent_key) continue;
+        if (!fd::arc_free(checker_, parent.pose, curvature, distance)) continue;
+        double cost = config_.primitive_length * (1.0 + config_.curve_weight * std::abs(steer) / steps);
+        if (direction < 0) cost *= 1.0 + config_.reverse_weight;
+        if (parent.direction != 0 && parent.direction != direction) cost += config_.direction_change_weight;
+        add_node({child_pose, parent.g + cost, index, static_cast<std::int8_t>(steer),
+                  static_cast<std::int8_t>(direction), false});
+      }
+    }
+  }
+
+  bool shoot(const Node& node, ReedsSheppPath& out) const {
+    if (!config_.use_back) return false;  // Reeds-Shepp words reverse; a forward-only search never shoots
+    std::vector<ReedsSheppPath> words = rs_.all(node.pose, goal_);
+    std::vector<std::pair<double, std::size_t>> order;
+    order.reserve(words.size());
+    for (std::size_t i = 0; i < words.size(); ++i)
+      order.emplace_back(weighted_cost(words[i], weights_, node.direction), i);
+    std::sort(order.begin(), order.end());
+    for (int tried = 0; tried < kShotCandidates && tried < static_cast<int>(order.size()); ++tried) {
+      const ReedsSheppPath& p = words[order[static_cast<std::size_t>(tried)].second];
+      if (shot_free(node.pose, p)) {
+        out = p;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  bool shot_free(const Pose2& from, const ReedsSheppPath& p) const {
+    // Coarse samples of the whole path first: a colliding shot usually fails there, cheaply.
+    for (const bool fine : {false, true}) {
+      Pose2 pose = from;
+      for (int i = 0; i < p.count; ++i) {
+        const ReedsSheppSegment& seg = p.segments[static_cast<std::size_t>(i)];
+        if (std::abs(seg.length) < 1e-9) continue;
+        const double k = static_cast<double>(static_cast<int>(seg.kind)) / config_.turning_radius;
+        const bool free = fine ? fd::arc_free(checker_, pose, k, seg.length)
+                               : fd::arc_samples_free(checker_, pose, k, seg.length, kCoarseSpacing);
+        if (!free) return false;
+        pose = fd::drive(pose, k, seg.length);
+      }
+    }
+    return true;
+  }
+
+  // Appends the poses of one arc (excluding `from`, including its end) at most
+  // waypoint_interval apart.
+  void append_arc(const Pose2& from, double curvature, double distance, std::vector<Waypoint>& out) const {
+    const int dir = distance < 0.0 ? -1 : 1;
+    const int n = std::max(1, static_cast<int>(std::ceil(std::abs(distance) / config_.waypoint_interval - 1e-9)));
+    for (int i = 1; i <= n; ++i) out.push_back({fd::drive(from, curvature, distance * i / n), dir});
+  }
+
+  void build_waypoints(const Finish& finish, HybridAStarResult& result) const {
+    std::vector<std::int32_t> chain;
+    for (std::int32_t i = finish.node; i >= 0; i = nodes_[static_cast<std::size_t>(i)].parent) chain.push_back(i);
+    std::reverse(chain.begin(), chain.end());
+    std::vector<Waypoint>& w = result.waypoints;
+    w.push_back({start_, 1});
+    for (std::size_t c = 1; c < chain.size(); ++c) {
+      const Node& n = nodes_[static_cast<std::size_t>(chain[c])];
+      const Node& parent = nodes_[static_cast<std::size_t>(n.parent)];
+      const double k = static_cast<double>(n.steer) / config_.turning_steps / config_.turning_radius;
+      append_arc(parent.pose, k, n.direction * config_.primitive_length, w);
+      result.length += config_.primitive_length;
+    }
+    if (finish.shot) {
+      Pose2 pose = nodes_[static_cast<std::size_t>(finish.node)].pose;
+      for (int i = 0; i < finish.path.count; ++i) {
+        const ReedsSheppSegment& seg = finish.path.segments[static_cast<std::size_t>(i)];
+        if (std::abs(seg.length) < 1e-9) continue;
+        const double k = static_cast<double>(static_cast<int>(seg.kind)) / config_.turning_radius;
+        append_arc(pose, k, seg.length, w);
+        pose = fd::drive(pose, k, seg.length);
+      }
+      result.length += finish.path.length;
+      w.back().pose = goal_;  // removes the rounding of the integration
+    }
+    if (w.size() >= 2) w.front().direction = w[1].direction;
+    if (w.size() == 1) w.push_back(w.front());  // start already in the goal region: a zero-length path
+  }
+
+  const GridCollisionChecker& checker_;
+  const Costmap& costmap_;
+  const HybridAStarConfig& config_;
+  Pose2 start_;
+  Pose2 goal_;
+  ReedsShepp rs_;
+  ReedsSheppWeights weights_;
+  fd::ObstacleHeuristic heuristic_;
+  std::vector<Node> nodes_;
+  fd::NodeTable table_;
+  using OpenItem = std::pair<double, std::int32_t>;
+  std::priority_queue<OpenItem, std::vector<OpenItem>, std::greater<OpenItem>> open_;
+};
+
+}  // namespace
+
+const char* to_string(HybridAStarResult::Status status) {
+  switch (status) {
+    case HybridAStarResult::Status::kSuccess:
+      return "success";
+    case HybridAStarResult::Status::kStartOccupied:
+      return "start occupied";
+    case HybridAStarResult::Status::kGoalOccupied:
+      return "goal occupied";
+    case HybridAStarResult::Status::kTimeout:
+      return "timeout";
+    case HybridAStarResult::Status::kNoPath:
+      return "no path";
+  }
+  return "invalid";
+}
+
+HybridAStar::HybridAStar(const GridCollisionChecker& checker, const HybridAStarConfig& config)
+    : checker_(checker), config_(config) {}
+
+HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const Deadline& deadline) const {
+  Search search(checker_, config_, start, goal);
+  return search.run(deadline);
+}
+
+}  // namespace pullout

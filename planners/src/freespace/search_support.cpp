@@ -1,0 +1,143 @@
+#include "search_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+namespace pullout::freespace_detail {
+
+Pose2 drive(const Pose2& from, double curvature, double distance) {
+  const double c = std::cos(from.yaw);
+  const double s = std::sin(from.yaw);
+  if (std::abs(curvature) < 1e-12) return {from.x + distance * c, from.y + distance * s, from.yaw};
+  const double dyaw = curvature * distance;
+  const double r = 1.0 / curvature;
+  const double yaw = from.yaw + dyaw;
+  return {from.x + r * (std::sin(yaw) - s), from.y + r * (c - std::cos(yaw)), yaw};
+}
+
+bool arc_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance) {
+  const double total = std::abs(distance);
+  const double sign = distance < 0.0 ? -1.0 : 1.0;
+  const double factor = checker.sweep_factor(curvature);
+  // Near obstacles, exact checks no more than half a cell of footprint motion apart.
+  const double min_step = 0.5 * checker.costmap().resolution() / factor;
+  double s = 0.0;
+  while (true) {
+    const Pose2 pose = drive(from, curvature, sign * s);
+    double clearance = 0.0;
+    if (checker.collides(pose, clearance)) return false;
+    // Nothing can be touched before the footprint has moved by its clearance.
+    const double step = std::max(min_step, clearance / factor);
+    if (s >= total) return true;
+    s = std::min(total, s + step);
+  }
+}
+
+bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance,
+                      double spacing) {
+  const int n = std::max(1, static_cast<int>(std::ceil(std::abs(distance) / spacing)));
+  for (int i = n; i >= 1; --i) {  // the end first: it is the likeliest to collide
+    if (checker.collides(drive(from, curvature, distance * i / n))) return false;
+  }
+  return true;
+}
+
+ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, double half_width, double cell_size, const Pose2& goal)
+    : costmap_(costmap) {
+  factor_ = std::max(1, static_cast<int>(std::round(cell_size / costmap.resolution())));
+  cell_size_ = factor_ * costmap.resolution();
+  width_ = (costmap.width() + factor_ - 1) / factor_;
+  height_ = (costmap.height() + factor_ - 1) / factor_;
+  const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  // A costmap cell is surely infeasible for the rear axle when even the most favourable point in
+  // it is closer than half_width to an obstacle (centre distance + half a diagonal each way).
+  const double slack = std::sqrt(2.0) * costmap.resolution();
+  std::vector<std::uint8_t> blocked(n, 1);
+  for (int j = 0; j < costmap.height(); ++j) {
+    for (int i = 0; i < costmap.width(); ++i) {
+      if (costmap.occupied(i, j)) continue;
+      if (costmap.centre_distance(i, j) + slack >= half_width) {
+        blocked[static_cast<std::size_t>(j / factor_) * width_ + (i / factor_)] = 0;
+      }
+    }
+  }
+  distance_.assign(n, std::numeric_limits<float>::infinity());
+  int gi = 0;
+  int gj = 0;
+  costmap.cell_of({goal.x, goal.y}, gi, gj);
+  if (!costmap.inside(gi, gj)) return;
+  gi /= factor_;
+  gj /= factor_;
+  using Item = std::pair<float, std::int32_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
+  const std::int32_t start = gj * width_ + gi;
+  distance_[static_cast<std::size_t>(start)] = 0.0F;
+  open.push({0.0F, start});
+  const float straight = static_cast<float>(cell_size_);
+  const float diagonal = static_cast<float>(cell_size_ * std::sqrt(2.0));
+  constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+  constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  while (!open.empty()) {
+    const auto [d, idx] = open.top();
+    open.pop();
+    if (d > distance_[static_cast<std::size_t>(idx)]) continue;
+    const int x = idx % width_;
+    const int y = idx / width_;
+    for (int k = 0; k < 8; ++k) {
+      const int nx = x + kDx[k];
+      const int ny = y + kDy[k];
+      if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
+      const std::int32_t nidx = ny * width_ + nx;
+      if (blocked[static_cast<std::size_t>(nidx)] != 0) continue;
+      const float nd = d + (k < 4 ? straight : diagonal);
+      if (nd < distance_[static_cast<std::size_t>(nidx)]) {
+        distance_[static_cast<std::size_t>(nidx)] = nd;
+        open.push({nd, nidx});
+      }
+    }
+  }
+}
+
+double ObstacleHeuristic::distance(const Pose2& p) const {
+  int i = 0;
+  int j = 0;
+  costmap_.cell_of({p.x, p.y}, i, j);
+  if (!costmap_.inside(i, j)) return std::numeric_limits<double>::infinity();
+  return distance_[static_cast<std::size_t>(j / factor_) * width_ + (i / factor_)];
+}
+
+NodeTable::NodeTable() {
+  keys_.assign(1u << 12, kEmptyKey);
+  values_.assign(keys_.size(), -1);
+  mask_ = keys_.size() - 1;
+}
+
+std::int32_t* NodeTable::find_or_insert(std::uint64_t key) {
+  if (2 * (size_ + 1) > keys_.size()) grow();
+  std::uint64_t h = (key * 0x9E3779B97F4A7C15ULL) >> 17;
+  while (true) {
+    const std::size_t i = static_cast<std::size_t>(h & mask_);
+    if (keys_[i] == key) return &values_[i];
+    if (keys_[i] == kEmptyKey) {
+      keys_[i] = key;
+      ++size_;
+      return &values_[i];
+    }
+    ++h;
+  }
+}
+
+void NodeTable::grow() {
+  std::vector<std::uint64_t> old_keys(keys_.size() * 2, kEmptyKey);
+  std::vector<std::int32_t> old_values(keys_.size() * 2, -1);
+  old_keys.swap(keys_);
+  old_values.swap(values_);
+  mask_ = keys_.size() - 1;
+  size_ = 0;
+  for (std::size_t i = 0; i < old_keys.size(); ++i) {
+    if (old_keys[i] != kEmptyKey) *find_or_insert(old_keys[i]) = old_values[i];
+  }
+}
+
+}  // namespace pullout::freespace_detail

@@ -1,0 +1,66 @@
+// Internal pieces of the hybrid A* search: driving arcs, checking them against the costmap, the
+// obstacle-aware distance heuristic, and the lattice's node table.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "pullout/freespace/costmap.hpp"
+#include "pullout/freespace/grid_collision_checker.hpp"
+#include "pullout/model/types.hpp"
+
+namespace pullout::freespace_detail {
+
+// The pose after driving `distance` [m] (negative: reverse) on an arc of `curvature` [1/m]
+// (0: straight; positive turns left) from `from`.
+Pose2 drive(const Pose2& from, double curvature, double distance);
+
+// True when the footprint stays clear of every occupied cell along the arc (see hybrid_astar.hpp
+// for the sampling rule), including both ends.
+bool arc_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance);
+
+// A quick necessary condition for arc_free: the poses every `spacing` [m] along the arc and its
+// end are free (exact tests). Most arcs that collide fail here at a fraction of the cost.
+bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance,
+                      double spacing);
+
+// Shortest 8-connected distance [m] from the goal to every cell of a coarse grid laid over the
+// costmap, through cells the rear-axle centre can occupy: a coarse cell is blocked only when
+// every costmap cell in it lies closer than `half_width` to an obstacle (the disc of that radius
+// around the rear axle lies inside the footprint), so no feasible pose is ever cut off.
+class ObstacleHeuristic {
+ public:
+  ObstacleHeuristic(const Costmap& costmap, double half_width, double cell_size, const Pose2& goal);
+
+  // Distance [m] from p (map frame) to the goal; +inf when the goal cannot be reached from p.
+  double distance(const Pose2& p) const;
+
+ private:
+  const Costmap& costmap_;
+  int factor_{1};  // costmap cells per coarse cell, per axis
+  int width_{0};
+  int height_{0};
+  double cell_size_{0.0};
+  std::vector<float> distance_;
+};
+
+// Open-addressing map from a lattice key to a node index.
+class NodeTable {
+ public:
+  NodeTable();
+  // The slot of `key`: *slot is -1 when the key is new (assign the node index to it).
+  std::int32_t* find_or_insert(std::uint64_t key);
+  std::size_t size() const { return size_; }
+
+ private:
+  void grow();
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::int32_t> values_;
+  std::size_t size_{0};
+  std::uint64_t mask_{0};
+};
+
+constexpr std::uint64_t kEmptyKey = std::numeric_limits<std::uint64_t>::max();
+
+}  // namespace pullout::freespace_detail

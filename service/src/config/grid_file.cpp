@@ -1,0 +1,249 @@
+#include "config/grid_file.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "pullout/collision/footprint.hpp"
+#include "pullout/freespace/costmap.hpp"
+
+namespace pullout {
+
+namespace {
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr long kMaxCells = 64L * 1024L * 1024L;
+
+// The next header token of a PGM file, skipping whitespace and '#' comments.
+bool next_token(const std::string& data, std::size_t& pos, std::string& token) {
+  token.clear();
+  while (pos < data.size()) {
+    const char c = data[pos];
+    if (c == '#') {
+      while (pos < data.size() && data[pos] != '\n') ++pos;
+    } else if (std::isspace(static_cast<unsigned char>(c)) != 0) {
+      ++pos;
+    } else {
+      break;
+    }
+  }
+  while (pos < data.size() && std::isspace(static_cast<unsigned char>(data[pos])) == 0) token += data[pos++];
+  return !token.empty();
+}
+
+bool parse_int(const std::string& s, long& v) {
+  if (s.empty() || s.size() > 9) return false;
+  for (char c : s) {
+    if (std::isdigit(static_cast<unsigned char>(c)) == 0) return false;
+  }
+  v = std::stol(s);
+  return true;
+}
+
+}  // namespace
+
+bool read_pgm(const std::string& file, PgmImage& out, std::vector<std::string>& problems) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    problems.push_back(file + ": cannot read file");
+    return false;
+  }
+  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::size_t pos = 0;
+  std::string magic, tw, th, tm;
+  long w = 0, h = 0, maxval = 0;
+  if (!next_token(data, pos, magic) || (magic != "P5" && magic != "P2")) {
+    problems.push_back(file + ": not a PGM image (expected P5 or P2)");
+    return false;
+  }
+  if (!next_token(data, pos, tw) || !next_token(data, pos, th) || !next_token(data, pos, tm) || !parse_int(tw, w) ||
+      !parse_int(th, h) || !parse_int(tm, maxval) || w < 1 || h < 1 || maxval < 1 || maxval > 65535 ||
+      w * h > kMaxCells) {
+    problems.push_back(file + ": bad PGM header (width, height, maxval in 1..65535)");
+    return false;
+  }
+  out.width = static_cast<int>(w);
+  out.height = static_cast<int>(h);
+  out.max_value = static_cast<int>(maxval);
+  const std::size_t n = static_cast<std::size_t>(w * h);
+  out.pixels.assign(n, 0);
+  if (magic == "P5") {
+    ++pos;  // the single whitespace after maxval
+    const std::size_t bytes = maxval > 255 ? 2 : 1;
+    if (data.size() < pos + n * bytes) {
+      problems.push_back(file + ": truncated PGM data");
+      return false;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto b0 = static_cast<unsigned char>(data[pos + i * bytes]);
+      out.pixels[i] =
+          bytes == 1 ? b0 : static_cast<std::uint16_t>((b0 << 8) | static_cast<unsigned char>(data[pos + i * 2 + 1]));
+    }
+  } else {
+    std::string t;
+    for (std::size_t i = 0; i < n; ++i) {
+      long v = 0;
+      if (!next_token(data, pos, t) || !parse_int(t, v) || v > maxval) {
+        problems.push_back(file + ": bad or missing pixel " + std::to_string(i) + " in P2 data");
+        return false;
+      }
+      out.pixels[i] = static_cast<std::uint16_t>(v);
+    }
+  }
+  return true;
+}
+
+bool load_map_server_grid(const std::string& yaml_file, const std::string& key_path, OccupancyGrid& out,
+                          std::vector<std::string>& problems) {
+  YAML::Node doc;
+  try {
+    doc = YAML::LoadFile(yaml_file);
+  } catch (const YAML::Exception& e) {
+    problems.push_back(key_path + ": " + yaml_file + ": " + e.what());
+    return false;
+  }
+  const std::size_t before = problems.size();
+  yaml_fields::MapReader r(doc, key_path, problems);
+  if (!r.valid()) return false;
+  std::string image;
+  double resolution = 0.0, occupied = 0.65, free = 0.196;
+  int negate = 0;
+  std::string mode = "trinary";
+  if (!r.read("image", image)) problems.push_back(r.key_path("image") + ": required");
+  if (!r.read("resolution", resolution) || !(resolution > 0.0)) {
+    problems.push_back(r.key_path("resolution") + ": required, > 0 [m]");
+  }
+  r.read("occupied_thresh", occupied);
+  r.read("free_thresh", free);
+  r.read("negate", negate);
+  r.read("mode", mode);
+  if (mode != "trinary") problems.push_back(r.key_path("mode") + ": only trinary is supported");
+  if (!(free >= 0.0 && free < occupied && occupied <= 1.0)) {
+    problems.push_back(r.key_path("occupied_thresh") + ": need 0 <= free_thresh < occupied_thresh <= 1");
+  }
+  Pose2 origin;
+  const YAML::Node o = r.get("origin");
+  if (!o.IsSequence() || o.size() != 3) {
+    problems.push_back(r.key_path("origin") + ": required, [x, y, yaw]");
+  } else {
+    const auto x = yaml_fields::to_double(o[0], r.key_path("origin") + "[0]", problems);
+    const auto y = yaml_fields::to_double(o[1], r.key_path("origin") + "[1]", problems);
+    const auto yaw = yaml_fields::to_double(o[2], r.key_path("origin") + "[2]", problems);
+    if (x && y && yaw) origin = {*x, *y, *yaw};
+  }
+  r.finish();
+  if (problems.size() != before) return false;
+  std::filesystem::path img(image);
+  if (img.is_relative()) img = std::filesystem::path(yaml_file).parent_path() / img;
+  PgmImage pgm;
+  if (!read_pgm(img.string(), pgm, problems)) return false;
+  out.resolution_m = resolution;
+  out.origin = origin;
+  out.width = static_cast<std::uint32_t>(pgm.width);
+  out.height = static_cast<std::uint32_t>(pgm.height);
+  out.data.assign(pgm.pixels.size(), -1);
+  for (int row = 0; row < pgm.height; ++row) {
+    for (int col = 0; col < pgm.width; ++col) {
+      const double v = pgm.pixels[static_cast<std::size_t>(row) * pgm.width + col] / static_cast<double>(pgm.max_value);
+      const double p = negate != 0 ? v : 1.0 - v;  // occupancy probability (dark = occupied)
+      const std::int8_t cell = p > occupied ? 100 : (p < free ? 0 : -1);
+      out.data[static_cast<std::size_t>(pgm.height - 1 - row) * pgm.width + col] = cell;
+    }
+  }
+  return true;
+}
+
+bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_dir, OccupancyGrid& out) {
+  yaml_fields::MapReader r(parent.get("grid"), "grid", parent.problems());
+  if (!r.valid()) return false;
+  auto& problems = r.problems();
+  const std::size_t before = problems.size();
+  if (r.has("map")) {
+    std::string file;
+    r.read("map", file);
+    r.finish();
+    std::filesystem::path path(file);
+    if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
+    return load_map_server_grid(path.string(), "grid.map", out, problems);
+  }
+  double resolution = 0.2;
+  r.read("resolution", resolution);
+  if (!(resolution > 0.0)) problems.push_back("grid.resolution: must be > 0 [m]");
+  Pose2 origin;
+  {
+    yaml_fields::MapReader o(r.get("origin"), "grid.origin", problems);
+    if (o.valid()) {
+      o.read("x", origin.x);
+      o.read("y", origin.y);
+      double yaw_deg = 0.0;
+      if (o.read("yaw_deg", yaw_deg)) origin.yaw = yaw_deg * kDegToRad;
+      o.read("yaw", origin.yaw);
+      o.finish();
+    }
+  }
+  const YAML::Node size = r.get("size");
+  double w = 0.0, h = 0.0;
+  if (!size.IsSequence() || size.size() != 2) {
+    problems.push_back("grid.size: required, [width, height] [m]");
+  } else {
+    w = yaml_fields::to_double(size[0], "grid.size[0]", problems).value_or(0.0);
+    h = yaml_fields::to_double(size[1], "grid.size[1]", problems).value_or(0.0);
+  }
+  std::vector<Polygon> shapes;
+  const YAML::Node obstacles = r.get("obstacles");
+  if (obstacles.IsDefined() && !obstacles.IsSequence()) problems.push_back("grid.obstacles: expected a list");
+  for (std::size_t i = 0; obstacles.IsSequence() && i < obstacles.size(); ++i) {
+    const std::string path = yaml_fields::indexed("grid.obstacles", i);
+    yaml_fields::MapReader b(obstacles[i], path, problems);
+    if (!b.valid()) continue;
+    if (b.has("polygon")) {
+      Polygon poly;
+      const YAML::Node pts = b.get("polygon");
+      for (std::size_t k = 0; pts.IsSequence() && k < pts.size(); ++k) {
+        if (!pts[k].IsSequence() || pts[k].size() != 2) {
+          problems.push_back(yaml_fields::indexed(path + ".polygon", k) + ": expected [x, y]");
+          continue;
+        }
+        const auto x = yaml_fields::to_double(pts[k][0], path + ".polygon.x", problems);
+        const auto y = yaml_fields::to_double(pts[k][1], path + ".polygon.y", problems);
+        if (x && y) poly.push_back({*x, *y});
+      }
+      if (poly.size() < 3) problems.push_back(path + ".polygon: needs at least 3 points");
+      shapes.push_back(poly);
+    } else {
+      Object box;
+      b.read("x", box.pose.x);
+      b.read("y", box.pose.y);
+      double yaw_deg = 0.0;
+      if (b.read("yaw_deg", yaw_deg)) box.pose.yaw = yaw_deg * kDegToRad;
+      b.read("length", box.length_m);
+      b.read("width", box.width_m);
+      if (!(box.length_m > 0.0 && box.width_m > 0.0)) problems.push_back(path + ": length and width must be > 0");
+      shapes.push_back(object_polygon(box));
+    }
+    b.finish();
+  }
+  r.finish();
+  if (problems.size() != before) return false;
+  const int cw = static_cast<int>(std::ceil(w / resolution - 1e-9));
+  const int ch = static_cast<int>(std::ceil(h / resolution - 1e-9));
+  if (cw < 1 || ch < 1 || static_cast<long>(cw) * ch > kMaxCells) {
+    problems.push_back("grid.size: must give 1 to " + std::to_string(kMaxCells) + " cells");
+    return false;
+  }
+  Costmap raster(origin, resolution, cw, ch, {});
+  raster.add_obstacles(shapes);
+  out.resolution_m = resolution;
+  out.origin = origin;
+  out.width = static_cast<std::uint32_t>(cw);
+  out.height = static_cast<std::uint32_t>(ch);
+  out.data.assign(static_cast<std::size_t>(cw) * ch, 0);
+  for (int j = 0; j < ch; ++j) {
+    for (int i = 0; i < cw; ++i) out.data[static_cast<std::size_t>(j) * cw + i] = raster.occupied(i, j) ? 100 : 0;
+  }
+  return true;
+}
+
+}  // namespace pullout

@@ -1,0 +1,189 @@
+// The freespace pull-out end to end (scenario files through the pipeline): what it returns must
+// be drivable. Oracles independent of the planner: the exact grid test of the footprint on a
+// costmap built here from the scenario, a plain polygon distance to the objects, Menger
+// curvature of consecutive points.
+#include "pullout/freespace/freespace_pull_out.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "pullout/collision/footprint.hpp"
+#include "pullout/config/scenario.hpp"
+#include "pullout/freespace/grid_collision_checker.hpp"
+#include "pullout/model/names.hpp"
+#include "pullout/pipeline/start_planner.hpp"
+
+namespace pullout {
+namespace {
+
+const char* const kFreespaceScenarios[] = {"freespace_boxed_in", "freespace_perpendicular_bay",
+                                           "freespace_parking_lot"};
+
+Scenario load(const std::string& name) {
+  return load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/" + name + ".yaml");
+}
+
+int direction_of(const PathWithLaneId& seg) {
+  for (const auto& p : seg.points) {
+    if (p.longitudinal_velocity_mps > 0.0) return 1;
+    if (p.longitudinal_velocity_mps < 0.0) return -1;
+  }
+  return 0;
+}
+
+double polyline_length(const PathWithLaneId& seg) {
+  double len = 0.0;
+  for (std::size_t i = 1; i < seg.points.size(); ++i) {
+    len += std::hypot(seg.points[i].pose.x - seg.points[i - 1].pose.x, seg.points[i].pose.y - seg.points[i - 1].pose.y);
+  }
+  return len;
+}
+
+class FreespaceScenario : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(FreespaceScenario, FindsADrivablePath) {
+  const Scenario sc = load(GetParam());
+  const StartPlanner planner(sc.vehicle, sc.parameters);
+  const PlanningResult r = planner.plan(sc.request, Deadline::after_ms(5000));
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  const PullOutPath& path = r.path;
+  EXPECT_EQ(path.planner_type, PlannerType::kFreespace);
+  EXPECT_EQ(r.evaluation_table.back().planner, PlannerType::kFreespace);
+  ASSERT_EQ(path.pairs_terminal_velocity_and_accel.size(), path.partial_paths.size());
+  EXPECT_NEAR(path.partial_paths[0].points[0].pose.x, sc.request.ego_pose.x, 1e-9);
+  EXPECT_NEAR(path.partial_paths[0].points[0].pose.y, sc.request.ego_pose.y, 1e-9);
+
+  // The costmap the planner searched, rebuilt here, and the exact test of the grown footprint.
+  const FreespaceParameters& fp = sc.parameters.freespace_planner;
+  std::vector<Polygon> objects;
+  for (const Object& o : sc.request.objects) objects.push_back(object_polygon(o));
+  const LaneWorld world(sc.request.lanes);
+  const Costmap costmap =
+      freespace_costmap(fp, sc.request.occupancy_grid ? &*sc.request.occupancy_grid : nullptr, &world, objects,
+                        sc.request.ego_pose, fp.end_pose_search_end_distance + sc.vehicle.length_m() + 10.0);
+  const GridCollisionChecker checker(costmap, freespace_footprint(sc.vehicle, fp));
+  const double k_max =
+      1.0 / (sc.vehicle.wheel_base_m / std::tan(sc.vehicle.max_steer_angle_rad * fp.max_turning_ratio));
+  const Footprint body = vehicle_footprint(sc.vehicle);
+
+  int cusps = 0;
+  for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
+    const auto& seg = path.partial_paths[k];
+    ASSERT_GE(seg.points.size(), 2u) << k;
+    const int dir = direction_of(seg);
+    ASSERT_NE(dir, 0) << k;
+    for (const auto& p : seg.points) EXPECT_GE(p.longitudinal_velocity_mps * dir, 0.0) << "one direction per segment";
+    const auto& pair = path.pairs_terminal_velocity_and_accel[k];
+    EXPECT_EQ(pair.velocity_mps > 0.0, dir > 0) << k;
+    EXPECT_GT(pair.accel_mps2 * dir, 0.0) << k;
+    if (k + 1 < path.partial_paths.size()) {
+      const auto& a = seg.points.back();
+      const auto& b = path.partial_paths[k + 1].points.front();
+      EXPECT_LT(std::hypot(a.pose.x - b.pose.x, a.pose.y - b.pose.y), 1e-9) << "join " << k;
+      if (direction_of(path.partial_paths[k + 1]) != dir) {
+        ++cusps;
+        EXPECT_DOUBLE_EQ(a.longitudinal_velocity_mps, 0.0) << "stop at the cusp after " << k;
+        EXPECT_NEAR(std::abs(pair.velocity_mps), fp.velocity, 1e-12);
+        // v reached at half of the segment, stopped at its end: a = v^2 / L.
+        EXPECT_NEAR(std::abs(pair.accel_mps2), fp.velocity * fp.velocity / polyline_length(seg), 1e-9);
+      }
+    }
+    for (std::size_t i = 0; i < seg.points.size(); ++i) {
+      const Pose2& pose = seg.points[i].pose;
+      // Up to the end pose the grown footprint is clear of the costmap; on the road after it,
+      // at least the body is clear of every object.
+      const bool on_road_tail = k + 1 == path.partial_paths.size() && sc.request.occupancy_grid == std::nullopt &&
+                                (pose.x - path.end_pose.x) * std::cos(path.end_pose.yaw) +
+                                        (pose.y - path.end_pose.y) * std::sin(path.end_pose.yaw) >
+                                    1e-6;
+      if (!on_road_tail) {
+        EXPECT_FALSE(checker.collides(pose)) << "segment " << k << " point " << i;
+      }
+      const Polygon fp_poly = footprint_polygon(body, pose);
+      for (const Polygon& o : objects) {
+        for (const Vec2& c : fp_poly) EXPECT_FALSE(point_in_polygon(o, c)) << "segment " << k << " point " << i;
+      }
+    }
+    for (std::size_t i = 1; i + 1 < seg.points.size(); ++i) {
+      const Vec2 a = to_vec(seg.points[i - 1].pose);
+      const Vec2 b = to_vec(seg.points[i].pose);
+      const Vec2 c = to_vec(seg.points[i + 1].pose);
+      const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+      const double denom = (b - a).norm() * (c - b).norm() * (c - a).norm();
+      if (denom > 1e-12) {
+        EXPECT_LE(std::abs(2.0 * cross / denom), k_max * 1.02) << "curvature, segment " << k << " point " << i;
+      }
+    }
+  }
+  RecordProperty("cusps", cusps);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenarios, FreespaceScenario, ::testing::ValuesIn(kFreespaceScenarios));
+
+TEST(FreespacePullOut, LanePlannersAloneCannotLeaveTheBoxedInSpot) {
+  Scenario sc = load("freespace_boxed_in");
+  sc.parameters.freespace_planner.enable_freespace_planner = false;
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+}
+
+TEST(FreespacePullOut, SplitsAtEveryCusp) {
+  std::vector<Waypoint> w;
+  for (int i = 0; i <= 4; ++i) w.push_back({{0.25 * i, 0.0, 0.0}, 1});
+  for (int i = 1; i <= 4; ++i) w.push_back({{1.0 - 0.25 * i, 0.0, 0.0}, -1});
+  for (int i = 1; i <= 2; ++i) w.push_back({{0.25 * i, 0.0, 0.0}, 1});
+  const SplitPath s = split_at_cusps(w, 1.5);
+  ASSERT_EQ(s.partial_paths.size(), 3u);
+  EXPECT_EQ(s.directions, (std::vector<int>{1, -1, 1}));
+  EXPECT_EQ(s.partial_paths[0].points.size(), 5u);
+  EXPECT_EQ(s.partial_paths[1].points.size(), 5u);  // the cusp point is in both neighbours
+  EXPECT_EQ(s.partial_paths[2].points.size(), 3u);
+  EXPECT_DOUBLE_EQ(s.partial_paths[0].points[1].longitudinal_velocity_mps, 1.5);
+  EXPECT_DOUBLE_EQ(s.partial_paths[1].points[1].longitudinal_velocity_mps, -1.5);
+  for (const auto& p : s.partial_paths) EXPECT_DOUBLE_EQ(p.points.back().longitudinal_velocity_mps, 0.0);
+  // 1 m at 1.5 m/s, stopping: a = v^2 / L.
+  EXPECT_DOUBLE_EQ(s.pairs[0].velocity_mps, 1.5);
+  EXPECT_DOUBLE_EQ(s.pairs[0].accel_mps2, 2.25);
+  EXPECT_DOUBLE_EQ(s.pairs[1].velocity_mps, -1.5);
+  EXPECT_DOUBLE_EQ(s.pairs[1].accel_mps2, -2.25);
+}
+
+TEST(FreespacePullOut, TinyDeadlineGivesATimeoutPromptly) {
+  const Scenario sc = load("freespace_perpendicular_bay");
+  const StartPlanner planner(sc.vehicle, sc.parameters);
+  const auto t0 = std::chrono::steady_clock::now();
+  const PlanningResult r = planner.plan(sc.request, Deadline::after_ms(1.0));
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  EXPECT_TRUE(r.timed_out);
+  EXPECT_LT(ms, 100.0);  // 1 ms budget + the costmap set-up, with slack for a loaded machine
+}
+
+TEST(FreespacePullOut, GridOnlyRequestsNeedTheFreespacePlanner) {
+  Scenario sc = load("freespace_parking_lot");
+  ASSERT_TRUE(sc.request.lanes.empty());
+  ASSERT_TRUE(sc.request.occupancy_grid.has_value());
+  sc.parameters.freespace_planner.enable_freespace_planner = false;
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
+  ASSERT_FALSE(r.issues.empty());
+  EXPECT_EQ(r.issues[0].field, "lanes");
+}
+
+TEST(FreespacePullOut, FreespaceInSearchPriorityRunsInItsPlace) {
+  Scenario sc = load("freespace_boxed_in");
+  sc.parameters.search_priority = {PlannerType::kFreespace};
+  sc.parameters.collision_check_margins = {0.1};
+  // The start candidates come from the lane-based search rules: keep the current pose one.
+  sc.parameters.collision_check_margin_from_front_object = 0.0;
+  sc.parameters.enable_back = false;
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline::after_ms(5000));
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  EXPECT_EQ(r.path.planner_type, PlannerType::kFreespace);
+  EXPECT_EQ(r.evaluation_table.back().outcome, "success");
+}
+
+}  // namespace
+}  // namespace pullout

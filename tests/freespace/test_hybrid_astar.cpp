@@ -1,0 +1,134 @@
+// Hybrid A* on small costmaps built in code: properties of what it returns (collision-free,
+// curvature, direction bookkeeping), its typed failures, and the deadline.
+#include "pullout/freespace/hybrid_astar.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+
+namespace pullout {
+namespace {
+
+constexpr double kRes = 0.2;
+
+// A w x h metre map with a wall of cells around it and the given occupied boxes (map frame).
+Costmap walled_map(double w, double h, const std::vector<Polygon>& boxes = {}) {
+  const int cw = static_cast<int>(std::round(w / kRes));
+  const int ch = static_cast<int>(std::round(h / kRes));
+  std::vector<std::uint8_t> occ(static_cast<std::size_t>(cw * ch), 0);
+  for (int i = 0; i < cw; ++i) occ[static_cast<std::size_t>(i)] = occ[static_cast<std::size_t>((ch - 1) * cw + i)] = 1;
+  for (int j = 0; j < ch; ++j)
+    occ[static_cast<std::size_t>(j * cw)] = occ[static_cast<std::size_t>(j * cw + cw - 1)] = 1;
+  Costmap m({}, kRes, cw, ch, std::move(occ));
+  m.add_obstacles(boxes);
+  return m;
+}
+
+Polygon box(double x0, double y0, double x1, double y1) { return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}; }
+
+const Footprint kCar{3.79, 1.1, 0.95, 0.95};
+
+HybridAStarConfig config() {
+  HybridAStarConfig c;
+  c.turning_radius = 5.2;
+  return c;
+}
+
+// The properties every found path has.
+void expect_drivable(const GridCollisionChecker& checker, const HybridAStarResult& r, const Pose2& start,
+                     double turning_radius) {
+  ASSERT_EQ(r.status, HybridAStarResult::Status::kSuccess);
+  ASSERT_GE(r.waypoints.size(), 2u);
+  EXPECT_NEAR(r.waypoints.front().pose.x, start.x, 1e-9);
+  EXPECT_NEAR(r.waypoints.front().pose.y, start.y, 1e-9);
+  for (const Waypoint& w : r.waypoints) {
+    EXPECT_FALSE(checker.collides(w.pose)) << w.pose.x << ", " << w.pose.y;
+    EXPECT_TRUE(w.direction == 1 || w.direction == -1);
+  }
+  for (std::size_t i = 1; i + 1 < r.waypoints.size(); ++i) {
+    const Vec2 a{r.waypoints[i - 1].pose.x, r.waypoints[i - 1].pose.y};
+    const Vec2 b{r.waypoints[i].pose.x, r.waypoints[i].pose.y};
+    const Vec2 c{r.waypoints[i + 1].pose.x, r.waypoints[i + 1].pose.y};
+    EXPECT_LE((b - a).norm(), 0.25 + 1e-9);
+    // Menger curvature within a cusp-free stretch.
+    if (r.waypoints[i].direction != r.waypoints[i + 1].direction) continue;
+    const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    const double denom = (b - a).norm() * (c - b).norm() * (c - a).norm();
+    if (denom > 1e-12) {
+      EXPECT_LE(std::abs(2.0 * cross / denom), 1.0 / turning_radius * 1.001) << i;
+    }
+  }
+}
+
+TEST(HybridAStar, OpenLotReachesTheExactGoal) {
+  const Costmap m = walled_map(30, 30);
+  const GridCollisionChecker checker(m, kCar);
+  const HybridAStar planner(checker, config());
+  const Pose2 start{6, 6, 0};
+  const Pose2 goal{22, 22, M_PI / 2};
+  const HybridAStarResult r = planner.plan(start, goal, Deadline::after_ms(2000));
+  expect_drivable(checker, r, start, 5.2);
+  EXPECT_TRUE(r.reached_exact_goal);
+  EXPECT_NEAR(r.waypoints.back().pose.x, goal.x, 1e-9);
+  EXPECT_NEAR(r.waypoints.back().pose.y, goal.y, 1e-9);
+}
+
+TEST(HybridAStar, GoalBehindAWallIsReachedAroundIt) {
+  // A wall across the middle with a gap at the top: the path must go through the gap.
+  const Costmap m = walled_map(30, 30, {box(14, 0, 15, 22)});
+  const GridCollisionChecker checker(m, kCar);
+  const HybridAStar planner(checker, config());
+  const Pose2 start{5, 5, 0};
+  const Pose2 goal{25, 5, 0};
+  const HybridAStarResult r = planner.plan(start, goal, Deadline::after_ms(3000));
+  expect_drivable(checker, r, start, 5.2);
+  double max_y = 0.0;
+  for (const auto& w : r.waypoints) max_y = std::max(max_y, w.pose.y);
+  EXPECT_GT(max_y, 22.0);
+}
+
+TEST(HybridAStar, TurningAroundInANarrowCorridorNeedsReversing) {
+  // A 7 m wide corridor: a U-turn needs at least one direction change.
+  const Costmap m = walled_map(40, 7.4);
+  const GridCollisionChecker checker(m, kCar);
+  const HybridAStar planner(checker, config());
+  const Pose2 start{20, 3.7, 0};
+  const Pose2 goal{20, 3.7, M_PI};
+  const HybridAStarResult r = planner.plan(start, goal, Deadline::after_ms(3000));
+  expect_drivable(checker, r, start, 5.2);
+  int changes = 0;
+  for (std::size_t i = 1; i < r.waypoints.size(); ++i) {
+    changes += r.waypoints[i].direction != r.waypoints[i - 1].direction ? 1 : 0;
+  }
+  EXPECT_GE(changes, 1);
+}
+
+TEST(HybridAStar, TypedFailures) {
+  const Costmap m = walled_map(30, 30, {box(14, 0, 15, 30)});  // a wall with no gap
+  const GridCollisionChecker checker(m, kCar);
+  const HybridAStar planner(checker, config());
+  EXPECT_EQ(planner.plan({14, 10, 0}, {25, 10, 0}, Deadline()).status, HybridAStarResult::Status::kStartOccupied);
+  EXPECT_EQ(planner.plan({5, 10, 0}, {14.5, 20, 0}, Deadline()).status, HybridAStarResult::Status::kGoalOccupied);
+  EXPECT_EQ(planner.plan({5, 10, 0}, {-50, 10, 0}, Deadline()).status, HybridAStarResult::Status::kGoalOccupied);
+  EXPECT_EQ(planner.plan({5, 10, 0}, {25, 10, 0}, Deadline::after_ms(5000)).status, HybridAStarResult::Status::kNoPath);
+}
+
+TEST(HybridAStar, DeadlineGivesATimeoutPromptly) {
+  // A large lot with the goal in a room whose door (1.7 m) is too narrow for the car but not for
+  // the heuristic's rear-axle disc: the search would exhaust the whole lot.
+  const Costmap m = walled_map(100, 100, {box(80, 80, 81, 88), box(80, 89.7, 81, 100), box(80, 80, 100, 81)});
+  const GridCollisionChecker checker(m, kCar);
+  const HybridAStar planner(checker, config());
+  const auto t0 = std::chrono::steady_clock::now();
+  const HybridAStarResult r = planner.plan({10, 10, 0}, {90, 90, 0}, Deadline::after_ms(5));
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.status, HybridAStarResult::Status::kTimeout);
+  // The deadline plus the fixed set-up (heuristic grid) and one check interval; generous for a
+  // loaded 2-core CI machine.
+  EXPECT_LT(ms, 100.0);
+  EXPECT_EQ(planner.plan({10, 10, 0}, {90, 90, 0}, Deadline::after_ms(0)).status, HybridAStarResult::Status::kTimeout);
+}
+
+}  // namespace
+}  // namespace pullout
