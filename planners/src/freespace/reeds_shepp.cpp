@@ -22,9 +22,10 @@ constexpr double kHalfPi = kPi / 2.0;
 constexpr double kTolerance = 1e-10;
 
 using Kind = ReedsSheppSegment::Kind;
-constexpr Kind L = Kind::kLeft;
-constexpr Kind S = Kind::kStraight;
-constexpr Kind R = Kind::kRight;
+// The paper's letters, so that the word tables below read as in Reeds & Shepp (1990).
+constexpr Kind L = Kind::kLeft;      // NOLINT(readability-identifier-naming)
+constexpr Kind S = Kind::kStraight;  // NOLINT(readability-identifier-naming)
+constexpr Kind R = Kind::kRight;     // NOLINT(readability-identifier-naming)
 
 // Angle wrapped into [-pi, pi].
 double wrap(double a) {
