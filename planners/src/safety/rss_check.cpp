@@ -258,26 +258,4 @@ std::optional<std::int64_t> moving_object_around(const Pose2& ego, const std::ve
   return std::nullopt;
 }
 
-bool SafetyObjectTypes::includes(ObjectClass c) const {
-  switch (c) {
-    case ObjectClass::kCar:
-      return check_car;
-    case ObjectClass::kTruck:
-      return check_truck;
-    case ObjectClass::kBus:
-      return check_bus;
-    case ObjectClass::kTrailer:
-      return check_trailer;
-    case ObjectClass::kBicycle:
-      return check_bicycle;
-    case ObjectClass::kMotorcycle:
-      return check_motorcycle;
-    case ObjectClass::kPedestrian:
-      return check_pedestrian;
-    case ObjectClass::kUnknown:
-      return check_unknown;
-  }
-  return false;
-}
-
 }  // namespace pullout

@@ -8,24 +8,11 @@
 #include <vector>
 
 #include "pullout/model/types.hpp"
+#include "pullout/pipeline/object_types.hpp"
 #include "pullout/safety/safety_parameters.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace pullout {
-
-// Which object classes the static collision check of path generation considers.
-struct ObjectTypesToCheck {
-  bool check_car{true};
-  bool check_truck{true};
-  bool check_bus{true};
-  bool check_trailer{true};
-  bool check_bicycle{true};
-  bool check_motorcycle{true};
-  bool check_pedestrian{true};
-  bool check_unknown{true};
-
-  bool includes(ObjectClass c) const;
-};
 
 // The freespace pull-out (hybrid A*), Autoware's `freespace_planner.` parameters. Unlike Autoware,
 // every key here is used.

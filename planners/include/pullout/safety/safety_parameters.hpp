@@ -6,21 +6,9 @@
 #include <string>
 
 #include "pullout/model/types.hpp"
+#include "pullout/pipeline/object_types.hpp"
 
 namespace pullout {
-
-// Object classes a safety check considers.
-struct SafetyObjectTypes {
-  bool check_car{true};
-  bool check_truck{true};
-  bool check_bus{true};
-  bool check_trailer{true};
-  bool check_bicycle{true};
-  bool check_motorcycle{true};
-  bool check_pedestrian{true};
-  bool check_unknown{false};
-  bool includes(ObjectClass c) const;
-};
 
 // How the ego is predicted to move along the current segment.
 struct EgoPredictedPathParameters {
@@ -41,7 +29,8 @@ struct TargetFilteringParameters {
   double object_check_forward_distance{10.0};     // [m] ahead of the ego, along the lane
   double object_check_backward_distance{100.0};   // [m] behind the ego, along the lane
   double ignore_object_velocity_threshold{0.25};  // [m/s] slower objects are not targets
-  SafetyObjectTypes object_types_to_check;
+  // Unknown objects are not checked (Autoware's default for the safety checks).
+  ObjectTypesToCheck object_types_to_check{true, true, true, true, true, true, true, false};
   bool check_current_lane{true};      // objects on the road lanes the path merges into
   bool check_shoulder_lane{true};     // objects on road shoulders
   bool use_all_predicted_path{true};  // false: only the most confident predicted path
@@ -80,7 +69,8 @@ struct PathSafetyCheckParameters {
 struct SurroundMovingObstacleCheckParameters {
   double search_radius{10.0};               // [m]
   double th_moving_obstacle_velocity{1.0};  // [m/s]
-  SafetyObjectTypes object_types_to_check;
+  // Unknown objects are not checked (Autoware's default for the safety checks).
+  ObjectTypesToCheck object_types_to_check{true, true, true, true, true, true, true, false};
 };
 
 // The stop inserted when the path becomes unsafe after departure.
