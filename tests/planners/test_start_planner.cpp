@@ -180,5 +180,25 @@ TEST(StartPlannerValidation, RouteWithoutMapAndBadDeadline) {
   EXPECT_TRUE(has_issue(r, "deadline_ms"));
 }
 
+TEST(StartPlanner, ReversingMovesBackwardsWhenTheVehicleFacesAgainstItsLane) {
+  // The shoulder is drawn westwards (its bounds run from x = 100 to 0) while the vehicle faces
+  // east, as a car parked against the shoulder's direction. A car close ahead makes it reverse:
+  // the reverse leg must go west (behind the vehicle), not east along the lane's direction.
+  auto req = test::straight_shoulder_request();
+  Lane& shoulder = req.lanes[1];
+  shoulder.left_bound = {{100.0, 1.75}, {-30.0, 1.75}};
+  shoulder.right_bound = {{100.0, 4.75}, {-30.0, 4.75}};
+  req.objects.push_back(test::parked_car(7, 19.04, 3.25));  // 3 m ahead of the bumper
+  StartPlannerParameters p;
+  p.search_priority = {PlannerType::kShift};
+  const PlanningResult r = StartPlanner(VehicleInfo{}, p).plan(req, Deadline());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  ASSERT_GE(r.path.partial_paths.size(), 2u);
+  const auto& reverse = r.path.partial_paths[0].points;
+  EXPECT_LT(reverse.front().longitudinal_velocity_mps, 0.0);
+  EXPECT_LT(reverse.back().pose.x, reverse.front().pose.x - 1.0) << "the reverse leg goes behind the vehicle";
+  for (const auto& pt : reverse) EXPECT_NEAR(std::cos(pt.pose.yaw), 1.0, 1e-6) << "the vehicle keeps facing east";
+}
+
 }  // namespace
 }  // namespace pullout
