@@ -47,6 +47,29 @@ void expect_found_path_invariants(const PullOutPath& path) {
   }
 }
 
+ExecutionProgress progress_sample(std::uint64_t request_id, std::int64_t stamp_ns, const Pose2& pose,
+                                  double velocity_mps, bool approved) {
+  ExecutionProgress p;
+  p.request_id = request_id;
+  p.stamp_ns = stamp_ns;
+  p.pose = pose;
+  p.velocity_mps = velocity_mps;
+  p.approved = approved;
+  return p;
+}
+
+ServiceTest::Sent ServiceTest::start_and_send(const std::string& scenario_name, const std::string& vehicle) {
+  Sent sent;
+  sent.scenario = load_test_scenario(scenario_name);
+  start_service();
+  sent.client = connect(vehicle);
+  if (sent.client == nullptr) return sent;
+  sent.id = sent.client->send(sent.scenario.request);
+  sent.path = sent.client->wait_for_path(sent.id, kReplyTimeout);
+  if (sent.path && sent.path->found) expect_found_path_invariants(*sent.path);
+  return sent;
+}
+
 void ServiceTest::start_service(const std::string& config_path) {
   ServiceOptions options;
   options.executable = PULLOUT_SERVICE_EXE;

@@ -36,6 +36,10 @@ Scenario load_test_scenario(const std::string& name);
 // consecutive partial paths join.
 void expect_found_path_invariants(const PullOutPath& path);
 
+// One odometry sample of the vehicle executing request `request_id`.
+ExecutionProgress progress_sample(std::uint64_t request_id, std::int64_t stamp_ns, const Pose2& pose,
+                                  double velocity_mps, bool approved = true);
+
 class ServiceTest : public ::testing::Test {
  protected:
   void TearDown() override;
@@ -48,6 +52,16 @@ class ServiceTest : public ::testing::Test {
   // it does not match within kMatchTimeout). profiles_file empty: the client's built-in
   // loopback defaults.
   std::unique_ptr<Client> connect(const std::string& vehicle, const std::string& profiles_file = "");
+
+  // Starts the service (default config), connects `vehicle`, sends the scenario's request and
+  // waits for its path (nullopt on timeout; a found path is checked against the invariants).
+  struct Sent {
+    Scenario scenario;
+    std::unique_ptr<Client> client;
+    std::uint64_t id{0};
+    std::optional<PullOutPath> path;
+  };
+  Sent start_and_send(const std::string& scenario_name, const std::string& vehicle);
 
   int domain() const { return service_ ? service_->domain() : -1; }
   ServiceProcess& service() { return *service_; }

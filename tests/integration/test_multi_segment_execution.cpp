@@ -19,23 +19,6 @@ using namespace std::chrono_literals;
 
 class MultiSegmentExecution : public ServiceTest {
  protected:
-  struct Planned {
-    std::unique_ptr<Client> client;
-    std::uint64_t id{0};
-    std::optional<PullOutPath> path;  // checked against the path invariants
-  };
-  // Starts the service, sends the scenario as `vehicle` and waits for the path.
-  Planned plan(const std::string& scenario_name, const std::string& vehicle) {
-    start_service();
-    Planned p;
-    p.client = connect(vehicle);
-    if (p.client == nullptr) return p;
-    p.id = p.client->send(load_test_scenario(scenario_name).request);
-    p.path = p.client->wait_for_path(p.id, kReplyTimeout);
-    if (p.path) expect_found_path_invariants(*p.path);
-    return p;
-  }
-
   // Drives the vehicle along every segment of `path`: one odometry sample per path point with
   // the path's (signed) velocity, stamps advancing at that speed; at the end of each segment but
   // the last it stands still (th_stopped_time is 1 s on the stamps) and expects the service to
@@ -43,13 +26,7 @@ class MultiSegmentExecution : public ServiceTest {
   void drive(Client& client, std::uint64_t id, const PullOutPath& path) {
     std::int64_t stamp_ns = 1'000'000'000;
     const auto report = [&](const Pose2& pose, double v) {
-      ExecutionProgress p;
-      p.request_id = id;
-      p.stamp_ns = stamp_ns;
-      p.pose = pose;
-      p.velocity_mps = v;
-      p.approved = true;
-      client.report_progress(p);
+      client.report_progress(progress_sample(id, stamp_ns, pose, v));
     };
     const std::size_t n = path.partial_paths.size();
     for (std::size_t k = 0; k < n; ++k) {
@@ -70,7 +47,9 @@ class MultiSegmentExecution : public ServiceTest {
         if (k + 1 < n && !last_point) {
           // Still on segment k: the index has not moved on.
           const auto st = client.latest_status();
-          if (st && st->request_id == id) EXPECT_EQ(st->current_path_idx, k) << "segment " << k << " point " << i;
+          if (st && st->request_id == id) {
+            EXPECT_EQ(st->current_path_idx, k) << "segment " << k << " point " << i;
+          }
         }
       }
       if (k + 1 < n) {
@@ -98,7 +77,7 @@ class MultiSegmentExecution : public ServiceTest {
 };
 
 TEST_F(MultiSegmentExecution, ReverseThenTwoArcsOutOfATightParallelSpot) {
-  const Planned p = plan("parallel_spot_reverse", "int-multi-arc");
+  const Sent p = start_and_send("parallel_spot_reverse", "int-multi-arc");
   ASSERT_TRUE(p.path);
   ASSERT_EQ(p.path->planner_type, PlannerType::kGeometric);
   ASSERT_EQ(p.path->partial_paths.size(), 3u) << "reverse, arc 1, arc 2";
@@ -115,7 +94,7 @@ TEST_F(MultiSegmentExecution, ReverseThenTwoArcsOutOfATightParallelSpot) {
 }
 
 TEST_F(MultiSegmentExecution, ReverseThenShiftWhenACarIsCloseAhead) {
-  const Planned p = plan("car_close_ahead", "int-multi-shift");
+  const Sent p = start_and_send("car_close_ahead", "int-multi-shift");
   ASSERT_TRUE(p.path);
   ASSERT_EQ(p.path->partial_paths.size(), 2u) << "reverse, shift";
   drive(*p.client, p.id, *p.path);

@@ -37,13 +37,7 @@ class SafeDeparture : public ServiceTest {
   void report(Client& client, std::uint64_t id, const Pose2& pose, double v, bool approved,
               std::int64_t dt_ns = 100'000'000) {
     stamp_ns_ += dt_ns;
-    ExecutionProgress p;
-    p.request_id = id;
-    p.stamp_ns = stamp_ns_;
-    p.pose = pose;
-    p.velocity_mps = v;
-    p.approved = approved;
-    client.report_progress(p);
+    client.report_progress(progress_sample(id, stamp_ns_, pose, v, approved));
     std::this_thread::sleep_for(50ms);
   }
 
@@ -62,12 +56,12 @@ class SafeDeparture : public ServiceTest {
 };
 
 TEST_F(SafeDeparture, NotExecutingUntilApproved) {
-  start_service();
-  const Scenario scenario = load_test_scenario("straight_shoulder");
-  auto client = connect("int-approval");
-  ASSERT_NE(client, nullptr);
-  const std::uint64_t id = client->send(scenario.request);
-  const auto path = client->wait_for_path(id, kReplyTimeout);
+  Sent sent = start_and_send("straight_shoulder", "int-approval");
+  ASSERT_NE(sent.client, nullptr);
+  Scenario& scenario = sent.scenario;
+  auto& client = sent.client;
+  const std::uint64_t id = sent.id;
+  const auto& path = sent.path;
   ASSERT_TRUE(path && path->found);
   const auto waiting = client->wait_for_status(
       id, [](const PullOutStatus& s) { return s.state == ExecutionState::kWaitingApproval; }, kReplyTimeout);
@@ -91,12 +85,12 @@ TEST_F(SafeDeparture, NotExecutingUntilApproved) {
 }
 
 TEST_F(SafeDeparture, FastCarFromBehindHoldsUntilItIsGone) {
-  start_service();
-  Scenario scenario = load_test_scenario("traffic_fast_from_behind");
-  auto client = connect("int-fast-car");
-  ASSERT_NE(client, nullptr);
-  const std::uint64_t id = client->send(scenario.request);
-  const auto path = client->wait_for_path(id, kReplyTimeout);
+  Sent sent = start_and_send("traffic_fast_from_behind", "int-fast-car");
+  ASSERT_NE(sent.client, nullptr);
+  Scenario& scenario = sent.scenario;
+  auto& client = sent.client;
+  const std::uint64_t id = sent.id;
+  const auto& path = sent.path;
   ASSERT_TRUE(path && path->found);
 
   const auto held = report_until(*client, id, scenario.request.ego_pose, 0.0, ExecutionState::kWaitingSafety);
@@ -217,12 +211,12 @@ TEST_F(SafeDeparture, CarAppearingAfterDepartureStopsThenResumes) {
 }
 
 TEST_F(SafeDeparture, ReSentRequestKeepsTheSegmentIndexOfALatchedMultiSegmentPath) {
-  start_service();
-  Scenario scenario = load_test_scenario("parallel_spot_reverse");
-  auto client = connect("int-latched");
-  ASSERT_NE(client, nullptr);
-  const std::uint64_t id = client->send(scenario.request);
-  const auto path = client->wait_for_path(id, kReplyTimeout);
+  Sent sent = start_and_send("parallel_spot_reverse", "int-latched");
+  ASSERT_NE(sent.client, nullptr);
+  Scenario& scenario = sent.scenario;
+  auto& client = sent.client;
+  const std::uint64_t id = sent.id;
+  const auto& path = sent.path;
   ASSERT_TRUE(path && path->found);
   ASSERT_EQ(path->partial_paths.size(), 3u) << "reverse, arc 1, arc 2";
   ASSERT_TRUE(report_until(*client, id, scenario.request.ego_pose, 0.0, ExecutionState::kExecuting));

@@ -71,13 +71,7 @@ TEST_F(PullOutFlow, StraightShoulderIsPlannedAndExecutedToCompletion) {
       const double v = std::max(std::abs(points[i].longitudinal_velocity_mps), 0.5);
       stamp_ns += static_cast<std::int64_t>(ds / v * 1e9);
     }
-    ExecutionProgress progress;
-    progress.request_id = id;
-    progress.stamp_ns = stamp_ns;
-    progress.pose = points[i].pose;
-    progress.velocity_mps = points[i].longitudinal_velocity_mps;
-    progress.approved = true;
-    client->report_progress(progress);
+    client->report_progress(progress_sample(id, stamp_ns, points[i].pose, points[i].longitudinal_velocity_mps));
     past_end = past_end || ahead_of(path->end_pose, points[i].pose) >= 0.0;
     const auto latest = client->latest_status();
     ASSERT_TRUE(latest);
