@@ -33,6 +33,7 @@
 #include <ompl/geometric/planners/informedtrees/BITstar.h>
 #include <ompl/geometric/planners/rrt/RRTstar.h>
 #include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
 
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
@@ -158,6 +159,7 @@ struct Run {
   double time_ms{0.0};
   double length{0.0};
   int direction_changes{0};
+  std::size_t expansions{0};
 };
 
 Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
@@ -172,6 +174,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   run.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   run.success = r.status == pullout::HybridAStarResult::Status::kSuccess;
   run.length = r.length;
+  run.expansions = r.expansions;
   for (std::size_t i = 1; i < r.waypoints.size(); ++i) {
     run.direction_changes += r.waypoints[i].direction != r.waypoints[i - 1].direction ? 1 : 0;
   }
@@ -246,7 +249,10 @@ double percentile(std::vector<double> v, double q) {
   const double pos = q * (v.size() - 1);
   const auto lo = static_cast<std::size_t>(std::floor(pos));
   const auto hi = std::min(v.size() - 1, lo + 1);
-  return v[lo] + (pos - lo) * (v[hi] - v[lo]);
+  const double frac = pos - static_cast<double>(lo);
+  if (frac == 0.0 || std::isinf(v[lo])) return v[lo];
+  if (std::isinf(v[hi])) return v[hi];  // between a success and a failure: unknown, above the budget
+  return v[lo] + frac * (v[hi] - v[lo]);
 }
 
 }  // namespace
@@ -256,13 +262,26 @@ int main(int argc, char** argv) {
   double budget_ms = 2000.0;
   unsigned seed = 5;
   double heuristic_weight = 1.5;  // astar.distance_heuristic_weight
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (std::strcmp(argv[i], "--problems") == 0) problems = std::atoi(argv[i + 1]);
-    if (std::strcmp(argv[i], "--budget-ms") == 0) budget_ms = std::atof(argv[i + 1]);
-    if (std::strcmp(argv[i], "--seed") == 0) seed = static_cast<unsigned>(std::atoi(argv[i + 1]));
-    if (std::strcmp(argv[i], "--heuristic-weight") == 0) heuristic_weight = std::atof(argv[i + 1]);
+  bool ours_only = false;          // --ours-only: skip OMPL, print search statistics
+  for (int i = 1; i < argc; ++i) {
+    const bool has_value = i + 1 < argc;
+    if (std::strcmp(argv[i], "--ours-only") == 0) {
+      ours_only = true;
+    } else if (has_value && std::strcmp(argv[i], "--problems") == 0) {
+      problems = std::atoi(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--budget-ms") == 0) {
+      budget_ms = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--seed") == 0) {
+      seed = static_cast<unsigned>(std::atoi(argv[++i]));
+    } else if (has_value && std::strcmp(argv[i], "--heuristic-weight") == 0) {
+      heuristic_weight = std::atof(argv[++i]);
+    } else {
+      std::fprintf(stderr, "unknown argument: %s\n", argv[i]);
+      return 2;
+    }
   }
   ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+  ompl::RNG::setSeed(seed);  // before any OMPL sampler exists: the peers' runs are reproducible too
   const pullout::VehicleInfo vehicle;
   const double radius = vehicle.wheel_base_m / std::tan(vehicle.max_steer_angle_rad * 0.7);  // max_turning_ratio 0.7
   const pullout::Footprint fp = pullout::vehicle_footprint(vehicle, kMargin);
@@ -278,6 +297,14 @@ int main(int argc, char** argv) {
       std::printf("%-18s invalid start or goal (generator bug)\n", p.name.c_str());
       return 1;
     }
+    if (ours_only) {
+      const Run r = run_ours(p, checker, radius, budget_ms, heuristic_weight);
+      runs[0].push_back(r);
+      std::printf("%-18s %8.1f ms %6.1f m %2d cusps %8zu expansions%s\n", p.name.c_str(), r.time_ms, r.length,
+                  r.direction_changes, r.expansions, r.success ? "" : "  (no solution)");
+      if (p.size == 30.0 && p.resolution > 0.15 && r.success) small_ours.push_back(r.time_ms);
+      continue;
+    }
     const Run r[3] = {run_ours(p, checker, radius, budget_ms, heuristic_weight),
                       run_ompl(p, checker, radius, budget_ms, false), run_ompl(p, checker, radius, budget_ms, true)};
     std::printf("%-18s", p.name.c_str());
@@ -292,22 +319,36 @@ int main(int argc, char** argv) {
     std::printf("\n");
     if (p.size == 30.0 && p.resolution > 0.15 && r[0].success) small_ours.push_back(r[0].time_ms);
   }
+  // Time to first solution of a failed run is unknown but above the budget: it counts as +inf in the
+  // medians and p95 over all problems (a censored sample; ">budget" when the quantile falls there).
+  // The median over successes only is printed too (it flatters a planner that fails often).
+  const auto fmt = [budget_ms](double v) {
+    char buf[32];
+    if (std::isinf(v)) {
+      std::snprintf(buf, sizeof buf, ">%.0f", budget_ms);
+    } else {
+      std::snprintf(buf, sizeof buf, "%.1f", v);
+    }
+    return std::string(buf);
+  };
   std::printf(
-      "\n| planner | success | median time to first solution [ms] | p95 [ms] | mean length [m] | mean direction "
-      "changes |\n");
-  std::printf("|---|---|---|---|---|---|\n");
-  for (int k = 0; k < 3; ++k) {
-    std::vector<double> t;
+      "\n| planner | success | median time to first solution [ms] | p95 [ms] | median over successes [ms] | mean "
+      "length [m] | mean direction changes |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
+  for (int k = 0; k < (ours_only ? 1 : 3); ++k) {
+    std::vector<double> all, solved;
     double len = 0.0, changes = 0.0;
     for (const Run& r : runs[k]) {
+      all.push_back(r.success ? r.time_ms : std::numeric_limits<double>::infinity());
       if (!r.success) continue;
-      t.push_back(r.time_ms);
+      solved.push_back(r.time_ms);
       len += r.length;
       changes += r.direction_changes;
     }
-    const double n = std::max<double>(1.0, static_cast<double>(t.size()));
-    std::printf("| %s | %zu/%zu | %.1f | %.1f | %.1f | %.2f |\n", names[k], t.size(), runs[k].size(),
-                percentile(t, 0.5), percentile(t, 0.95), len / n, changes / n);
+    const double n = std::max<double>(1.0, static_cast<double>(solved.size()));
+    std::printf("| %s | %zu/%zu | %s | %s | %s | %.1f | %.2f |\n", names[k], solved.size(), runs[k].size(),
+                fmt(percentile(all, 0.5)).c_str(), fmt(percentile(all, 0.95)).c_str(),
+                fmt(percentile(solved, 0.5)).c_str(), len / n, changes / n);
   }
   std::printf("\nhybrid A* median on 30 m x 30 m at 0.2 m: %.1f ms (%zu problems)\n", percentile(small_ours, 0.5),
               small_ours.size());

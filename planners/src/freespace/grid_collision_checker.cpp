@@ -68,8 +68,10 @@ bool GridCollisionChecker::collides(const Pose2& pose) const {
 }
 
 bool GridCollisionChecker::collides(const Pose2& pose, double& bound) const {
-  const double c = std::cos(pose.yaw);
-  const double s = std::sin(pose.yaw);
+  return collides(pose, std::cos(pose.yaw), std::sin(pose.yaw), bound);
+}
+
+bool GridCollisionChecker::collides(const Pose2& pose, double c, double s, double& bound) const {
   bound = clearance_bound(pose, c, s);
   if (bound > 0.0) return false;
   return collides_exact(pose, c, s);

@@ -25,6 +25,8 @@ class GridCollisionChecker {
   bool collides(const Pose2& pose) const;
   // The same, also giving clearance_lower_bound(pose) (0 when the exact test had to run).
   bool collides(const Pose2& pose, double& clearance_bound) const;
+  // The same with cos(pose.yaw) and sin(pose.yaw) given (callers that already have them).
+  bool collides(const Pose2& pose, double cos_yaw, double sin_yaw, double& clearance_bound) const;
 
   // A lower bound [m] of the distance from the footprint at `pose` to the nearest occupied cell
   // (0 when it may touch one). Cheap: a few distance-transform lookups.
