@@ -262,7 +262,7 @@ int main(int argc, char** argv) {
   double budget_ms = 2000.0;
   unsigned seed = 5;
   double heuristic_weight = 1.5;  // astar.distance_heuristic_weight
-  bool ours_only = false;          // --ours-only: skip OMPL, print search statistics
+  bool ours_only = false;         // --ours-only: skip OMPL, print search statistics
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(argv[i], "--ours-only") == 0) {
