@@ -165,6 +165,12 @@ struct Run {
 Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
              double heuristic_weight) {
   pullout::HybridAStarConfig config;
+  if (std::getenv("HA_THETA")) config.theta_size = std::atoi(std::getenv("HA_THETA"));
+  if (std::getenv("HA_XY")) config.xy_resolution = std::atof(std::getenv("HA_XY"));
+  if (std::getenv("HA_PRIM")) config.primitive_length = std::atof(std::getenv("HA_PRIM"));
+  std::vector<Pose2> expanded;
+  const char* dump = std::getenv("PULLOUT_DUMP_EXPANSIONS");  // directory: <problem index>.pgm / .txt
+  if (dump != nullptr) config.expanded_poses = &expanded;
   config.turning_radius = radius;
   config.distance_heuristic_weight = heuristic_weight;
   const pullout::HybridAStar planner(checker, config);
@@ -175,6 +181,24 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   run.success = r.status == pullout::HybridAStarResult::Status::kSuccess;
   run.length = r.length;
   run.expansions = r.expansions;
+  if (dump != nullptr) {
+    // A picture of the search: the costmap as a PGM (north up) and the expanded poses as text.
+    static int index = 0;
+    const std::string base = std::string(dump) + "/" + std::to_string(index++);
+    if (FILE* f = std::fopen((base + ".pgm").c_str(), "w")) {
+      std::fprintf(f, "P5 %d %d 255\n", p.costmap.width(), p.costmap.height());
+      for (int y = p.costmap.height() - 1; y >= 0; --y) {
+        for (int x = 0; x < p.costmap.width(); ++x) std::fputc(p.costmap.occupied(x, y) ? 0 : 255, f);
+      }
+      std::fclose(f);
+    }
+    if (FILE* f = std::fopen((base + ".txt").c_str(), "w")) {
+      std::fprintf(f, "# resolution %g start %g %g %g goal %g %g %g\n", p.resolution, p.start.x, p.start.y, p.start.yaw,
+                   p.goal.x, p.goal.y, p.goal.yaw);
+      for (const Pose2& e : expanded) std::fprintf(f, "E %g %g %g 0 0\n", e.x, e.y, e.yaw);
+      std::fclose(f);
+    }
+  }
   for (std::size_t i = 1; i < r.waypoints.size(); ++i) {
     run.direction_changes += r.waypoints[i].direction != r.waypoints[i - 1].direction ? 1 : 0;
   }
@@ -261,7 +285,7 @@ int main(int argc, char** argv) {
   int problems = 24;
   double budget_ms = 2000.0;
   unsigned seed = 5;
-  double heuristic_weight = 1.5;  // astar.distance_heuristic_weight
+  double heuristic_weight = 2.0;  // astar.distance_heuristic_weight (its default)
   bool ours_only = false;         // --ours-only: skip OMPL, print search statistics
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;

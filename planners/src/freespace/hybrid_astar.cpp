@@ -30,6 +30,7 @@ struct Node {
   Pose2 pose;
   double g{0.0};
   std::int32_t parent{-1};
+  float clearance{0.0F};     // [m] clearance lower bound of the footprint at `pose` (0: near)
   std::int8_t steer{0};      // steer index of the primitive that led here
   std::int8_t direction{0};  // +1 / -1 of that primitive, 0 at the start
   bool closed{false};
@@ -56,7 +57,8 @@ class Search {
 
   HybridAStarResult run(const Deadline& deadline) {
     HybridAStarResult result;
-    if (checker_.collides(start_)) {
+    double start_clearance = 0.0;
+    if (checker_.collides(start_, start_clearance)) {
       result.status = HybridAStarResult::Status::kStartOccupied;
       return result;
     }
@@ -64,7 +66,10 @@ class Search {
       result.status = HybridAStarResult::Status::kGoalOccupied;
       return result;
     }
-    add_node({start_, 0.0, -1, 0, 0, false});
+    Node start_node;
+    start_node.pose = start_;
+    start_node.clearance = static_cast<float>(start_clearance);
+    add_node(start_node);
     Finish finish;
     std::size_t since_shot = 0;
     while (!open_.empty()) {
@@ -78,6 +83,7 @@ class Search {
       nodes_[static_cast<std::size_t>(index)].closed = true;
       ++result.expansions;
       const Node node = nodes_[static_cast<std::size_t>(index)];
+      if (config_.expanded_poses != nullptr) config_.expanded_poses->push_back(node.pose);
       if (in_goal_region(node.pose)) {
         finish.node = index;
         break;
@@ -87,6 +93,7 @@ class Search {
       const auto interval = static_cast<std::size_t>(std::max(1.0, h2d / kShotDistancePerInterval));
       if (++since_shot >= interval) {
         since_shot = 0;
+        ++result.shots;
         if (shoot(node, finish.path)) {
           finish.node = index;
           finish.shot = true;
@@ -109,7 +116,7 @@ class Search {
 
  private:
   double xy_resolution() const {
-    return config_.xy_resolution > 0.0 ? config_.xy_resolution : config_.primitive_length / std::sqrt(2.0);
+    return config_.xy_resolution > 0.0 ? config_.xy_resolution : config_.primitive_length;
   }
 
   std::uint64_t key(const Pose2& p) const {
@@ -166,19 +173,31 @@ class Search {
     const Node parent = nodes_[static_cast<std::size_t>(index)];
     const std::uint64_t parent_key = key(parent.pose);
     const int steps = config_.turning_steps;
+    const double length = config_.primitive_length;
+    const double c = std::cos(parent.pose.yaw);
+    const double s = std::sin(parent.pose.yaw);
     for (const int direction : {1, -1}) {
       if (direction < 0 && !config_.use_back) continue;
       for (int steer = -steps; steer <= steps; ++steer) {
-        const double curvature = static_cast<double>(steer) / steps / config_.turning_radius;
-        const double distance = direction * config_.primitive_length;
-        const Pose2 child_pose = fd::drive(parent.pose, curvature, distance);
+        const fd::Arc arc(parent.pose, c, s, static_cast<double>(steer) / steps / config_.turning_radius);
+        const double distance = direction * length;
+        double unused_c = 0.0;
+        double unused_s = 0.0;
+        const Pose2 child_pose = arc.at(distance, unused_c, unused_s);
         if (key(child_pose) == parent_key) continue;
-        if (!fd::arc_free(checker_, parent.pose, curvature, distance)) continue;
-        double cost = config_.primitive_length * (1.0 + config_.curve_weight * std::abs(steer) / steps);
+        double clearance = 0.0;
+        if (!fd::arc_free(checker_, arc, parent.clearance, distance, clearance)) continue;
+        double cost = length * (1.0 + config_.curve_weight * std::abs(steer) / steps);
         if (direction < 0) cost *= 1.0 + config_.reverse_weight;
         if (parent.direction != 0 && parent.direction != direction) cost += config_.direction_change_weight;
-        add_node({child_pose, parent.g + cost, index, static_cast<std::int8_t>(steer),
-                  static_cast<std::int8_t>(direction), false});
+        Node child;
+        child.pose = child_pose;
+        child.g = parent.g + cost;
+        child.parent = index;
+        child.clearance = static_cast<float>(clearance);
+        child.steer = static_cast<std::int8_t>(steer);
+        child.direction = static_cast<std::int8_t>(direction);
+        add_node(child);
       }
     }
   }
@@ -193,7 +212,7 @@ class Search {
     std::sort(order.begin(), order.end());
     for (int tried = 0; tried < kShotCandidates && tried < static_cast<int>(order.size()); ++tried) {
       const ReedsSheppPath& p = words[order[static_cast<std::size_t>(tried)].second];
-      if (shot_free(node.pose, p)) {
+      if (shot_free(node, p)) {
         out = p;
         return true;
       }
@@ -201,15 +220,16 @@ class Search {
     return false;
   }
 
-  bool shot_free(const Pose2& from, const ReedsSheppPath& p) const {
+  bool shot_free(const Node& from, const ReedsSheppPath& p) const {
     // Coarse samples of the whole path first: a colliding shot usually fails there, cheaply.
     for (const bool fine : {false, true}) {
-      Pose2 pose = from;
+      Pose2 pose = from.pose;
+      double clearance = from.clearance;
       for (int i = 0; i < p.count; ++i) {
         const ReedsSheppSegment& seg = p.segments[static_cast<std::size_t>(i)];
         if (std::abs(seg.length) < 1e-9) continue;
         const double k = static_cast<double>(static_cast<int>(seg.kind)) / config_.turning_radius;
-        const bool free = fine ? fd::arc_free(checker_, pose, k, seg.length)
+        const bool free = fine ? fd::arc_free(checker_, fd::Arc(pose, k), clearance, seg.length, clearance)
                                : fd::arc_samples_free(checker_, pose, k, seg.length, kCoarseSpacing);
         if (!free) return false;
         pose = fd::drive(pose, k, seg.length);

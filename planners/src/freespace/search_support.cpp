@@ -16,21 +16,44 @@ Pose2 drive(const Pose2& from, double curvature, double distance) {
   return {from.x + r * (std::sin(yaw) - s), from.y + r * (c - std::cos(yaw)), yaw};
 }
 
-bool arc_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance) {
+Arc::Arc(const Pose2& from, double curvature) : Arc(from, std::cos(from.yaw), std::sin(from.yaw), curvature) {}
+
+Arc::Arc(const Pose2& from, double cos_yaw, double sin_yaw, double curvature)
+    : from_(from), cos_(cos_yaw), sin_(sin_yaw), curvature_(curvature) {}
+
+Pose2 Arc::at(double distance, double& cos_yaw, double& sin_yaw) const {
+  if (std::abs(curvature_) < 1e-12) {
+    cos_yaw = cos_;
+    sin_yaw = sin_;
+    return {from_.x + distance * cos_, from_.y + distance * sin_, from_.yaw};
+  }
+  const double yaw = from_.yaw + curvature_ * distance;
+  cos_yaw = std::cos(yaw);
+  sin_yaw = std::sin(yaw);
+  const double r = 1.0 / curvature_;
+  return {from_.x + r * (sin_yaw - sin_), from_.y + r * (cos_ - cos_yaw), yaw};
+}
+
+bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+              double& end_clearance) {
   const double total = std::abs(distance);
   const double sign = distance < 0.0 ? -1.0 : 1.0;
-  const double factor = checker.sweep_factor(curvature);
+  const double factor = checker.sweep_factor(arc.curvature());
   // Near obstacles, exact checks no more than half a cell of footprint motion apart.
   const double min_step = 0.5 * checker.costmap().resolution() / factor;
-  double s = 0.0;
+  // Nothing can be touched before the footprint has moved by its clearance.
+  double s = std::min(total, std::max(min_step, start_clearance / factor));
   while (true) {
-    const Pose2 pose = drive(from, curvature, sign * s);
+    double c = 1.0;
+    double sn = 0.0;
+    const Pose2 pose = arc.at(sign * s, c, sn);
     double clearance = 0.0;
-    if (checker.collides(pose, clearance)) return false;
-    // Nothing can be touched before the footprint has moved by its clearance.
-    const double step = std::max(min_step, clearance / factor);
-    if (s >= total) return true;
-    s = std::min(total, s + step);
+    if (checker.collides(pose, c, sn, clearance)) return false;
+    if (s >= total) {
+      end_clearance = clearance;
+      return true;
+    }
+    s = std::min(total, s + std::max(min_step, clearance / factor));
   }
 }
 

@@ -16,9 +16,29 @@ namespace pullout::freespace_detail {
 // (0: straight; positive turns left) from `from`.
 Pose2 drive(const Pose2& from, double curvature, double distance);
 
+// An arc from a pose: its start, with cos and sin of the start heading computed once, and the
+// pose after any length along it (one sincos per pose).
+class Arc {
+ public:
+  Arc(const Pose2& from, double curvature);
+  Arc(const Pose2& from, double cos_yaw, double sin_yaw, double curvature);
+  // The pose after `distance` [m] (negative: reverse), with cos and sin of its heading.
+  Pose2 at(double distance, double& cos_yaw, double& sin_yaw) const;
+  double curvature() const { return curvature_; }
+
+ private:
+  Pose2 from_;
+  double cos_{1.0};
+  double sin_{0.0};
+  double curvature_{0.0};
+};
+
 // True when the footprint stays clear of every occupied cell along the arc (see hybrid_astar.hpp
-// for the sampling rule), including both ends.
-bool arc_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance);
+// for the sampling rule), including its end. The start is known to be free with clearance lower
+// bound `start_clearance` [m] (0 when unknown beyond being free): it is not tested again.
+// `end_clearance` receives the end pose's clearance bound.
+bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+              double& end_clearance);
 
 // A quick necessary condition for arc_free: the poses every `spacing` [m] along the arc and its
 // end are free (exact tests). Most arcs that collide fail here at a fraction of the cost.

@@ -41,7 +41,7 @@ struct FreespaceParameters {
   } costmap_configs;
   struct Astar {
     bool use_back{true};                    // reverse primitives
-    double distance_heuristic_weight{1.0};  // > 1: faster, less optimal
+    double distance_heuristic_weight{2.0};  // > 1: faster, less optimal (Autoware default)
     double expansion_distance{0.5};         // [m] arc length of a motion primitive
   } astar;
 };
