@@ -1,7 +1,12 @@
 // Freespace benchmark: our hybrid A* against OMPL's RRT* and BIT* on the same problems, in the
 // same run, with the same collision test and the same time budget.
 //
-//   build/bench/bench_freespace [--problems 24] [--budget-ms 2000] [--seed 5] [--heuristic-weight 1.5]
+//   build/bench/bench_freespace [--problems 24] [--budget-ms 2000] [--seed 5] [--heuristic-weight 2.0]
+//                               [--theta-size N] [--xy-resolution M] [--ours-only]
+//
+// --ours-only skips OMPL and prints the expansions of each search. With the environment variable
+// PULLOUT_DUMP_EXPANSIONS=<dir>, each problem's costmap (<i>.pgm) and the poses our search expanded
+// (<i>.txt: "E x y yaw" lines) are written there, to see where a search spends its time.
 //
 // Problems: parking lots 30-100 m across, 0.1 or 0.2 m cells, walls around, rows of
 // perpendicular bays with parked cars (each bay taken with probability 0.7), generated from a
@@ -154,6 +159,12 @@ Problem make_problem(int index, std::mt19937& rng, const pullout::Footprint& fp)
   return p;
 }
 
+// Search settings from the command line (0: the planner's default).
+struct SearchOverrides {
+  int theta_size{0};
+  double xy_resolution{0.0};
+} g_search;
+
 struct Run {
   bool success{false};
   double time_ms{0.0};
@@ -165,9 +176,8 @@ struct Run {
 Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
              double heuristic_weight) {
   pullout::HybridAStarConfig config;
-  if (std::getenv("HA_THETA")) config.theta_size = std::atoi(std::getenv("HA_THETA"));
-  if (std::getenv("HA_XY")) config.xy_resolution = std::atof(std::getenv("HA_XY"));
-  if (std::getenv("HA_PRIM")) config.primitive_length = std::atof(std::getenv("HA_PRIM"));
+  config.theta_size = g_search.theta_size > 0 ? g_search.theta_size : config.theta_size;
+  config.xy_resolution = g_search.xy_resolution;
   std::vector<Pose2> expanded;
   const char* dump = std::getenv("PULLOUT_DUMP_EXPANSIONS");  // directory: <problem index>.pgm / .txt
   if (dump != nullptr) config.expanded_poses = &expanded;
@@ -297,6 +307,10 @@ int main(int argc, char** argv) {
       budget_ms = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--seed") == 0) {
       seed = static_cast<unsigned>(std::atoi(argv[++i]));
+    } else if (has_value && std::strcmp(argv[i], "--theta-size") == 0) {
+      g_search.theta_size = std::atoi(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--xy-resolution") == 0) {
+      g_search.xy_resolution = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--heuristic-weight") == 0) {
       heuristic_weight = std::atof(argv[++i]);
     } else {
