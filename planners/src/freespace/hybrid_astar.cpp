@@ -53,7 +53,7 @@ class Search {
         goal_(goal),
         rs_(config.turning_radius),
         weights_{config.curve_weight, config.reverse_weight, config.direction_change_weight},
-        heuristic_(costmap_, 0.5 * checker.footprint().width(), xy_resolution(), goal) {}
+        heuristic_(costmap_, heuristic_config(checker, config), goal) {}
 
   HybridAStarResult run(const Deadline& deadline) {
     HybridAStarResult result;
@@ -115,8 +115,21 @@ class Search {
   }
 
  private:
-  double xy_resolution() const {
-    return config_.xy_resolution > 0.0 ? config_.xy_resolution : config_.primitive_length;
+  static double xy_resolution(const HybridAStarConfig& config) {
+    return config.xy_resolution > 0.0 ? config.xy_resolution : config.primitive_length;
+  }
+  double xy_resolution() const { return xy_resolution(config_); }
+
+  static fd::ObstacleHeuristicConfig heuristic_config(const GridCollisionChecker& checker,
+                                                      const HybridAStarConfig& config) {
+    const Footprint& f = checker.footprint();
+    fd::ObstacleHeuristicConfig h;
+    h.half_width = 0.5 * f.width();
+    h.cell_size = xy_resolution(config);
+    // The room the body needs to turn about its middle: half its diagonal.
+    h.turning_room = 0.5 * std::hypot(f.length(), f.width());
+    h.narrow_penalty = config.narrow_heuristic_penalty;
+    return h;
   }
 
   std::uint64_t key(const Pose2& p) const {

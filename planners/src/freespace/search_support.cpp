@@ -66,9 +66,10 @@ bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, do
   return true;
 }
 
-ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, double half_width, double cell_size, const Pose2& goal)
+ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal)
     : costmap_(costmap) {
-  factor_ = std::max(1, static_cast<int>(std::round(cell_size / costmap.resolution())));
+  const double half_width = config.half_width;
+  factor_ = std::max(1, static_cast<int>(std::round(config.cell_size / costmap.resolution())));
   cell_size_ = factor_ * costmap.resolution();
   width_ = (costmap.width() + factor_ - 1) / factor_;
   height_ = (costmap.height() + factor_ - 1) / factor_;
@@ -77,13 +78,21 @@ ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, double half_width, 
   // it is closer than half_width to an obstacle (centre distance + half a diagonal each way).
   const double slack = std::sqrt(2.0) * costmap.resolution();
   std::vector<std::uint8_t> blocked(n, 1);
+  std::vector<float> room(n, 0.0F);
   for (int j = 0; j < costmap.height(); ++j) {
     for (int i = 0; i < costmap.width(); ++i) {
       if (costmap.occupied(i, j)) continue;
-      if (costmap.centre_distance(i, j) + slack >= half_width) {
-        blocked[static_cast<std::size_t>(j / factor_) * width_ + (i / factor_)] = 0;
-      }
+      const std::size_t c = static_cast<std::size_t>(j / factor_) * width_ + (i / factor_);
+      const double d = costmap.centre_distance(i, j);
+      room[c] = std::max(room[c], static_cast<float>(d));
+      if (d + slack >= half_width) blocked[c] = 0;
     }
+  }
+  // Per-metre cost of crossing each cell; an edge costs the mean of its two cells'.
+  std::vector<float>& rate = room;  // reused in place
+  for (float& r : rate) {
+    const double narrowness = std::max(0.0, 1.0 - r / config.turning_room);
+    r = static_cast<float>(1.0 + config.narrow_penalty * narrowness);
   }
   distance_.assign(n, std::numeric_limits<float>::infinity());
   int gi = 0;
@@ -113,7 +122,9 @@ ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, double half_width, 
       if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
       const std::int32_t nidx = ny * width_ + nx;
       if (blocked[static_cast<std::size_t>(nidx)] != 0) continue;
-      const float nd = d + (k < 4 ? straight : diagonal);
+      const float step = (k < 4 ? straight : diagonal) * 0.5F *
+                         (rate[static_cast<std::size_t>(idx)] + rate[static_cast<std::size_t>(nidx)]);
+      const float nd = d + step;
       if (nd < distance_[static_cast<std::size_t>(nidx)]) {
         distance_[static_cast<std::size_t>(nidx)] = nd;
         open.push({nd, nidx});

@@ -49,9 +49,23 @@ bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, do
 // costmap, through cells the rear-axle centre can occupy: a coarse cell is blocked only when
 // every costmap cell in it lies closer than `half_width` to an obstacle (the disc of that radius
 // around the rear axle lies inside the footprint), so no feasible pose is ever cut off.
+//
+// Narrow places cost more: crossing a cell whose room (the largest obstacle distance in it) is
+// below `turning_room` costs 1 + narrow_penalty * (1 - room / turning_room) per metre. A gap the
+// rear axle fits through is often one the vehicle cannot turn into; without the charge the plain
+// distance leads the search into such gaps, where it floods every heading before it gives up
+// (the cost-aware obstacle heuristic of Nav2's Smac planner follows the same idea). The result is
+// no longer a lower bound, like any weighted heuristic. narrow_penalty 0: the plain distance.
+struct ObstacleHeuristicConfig {
+  double half_width{1.0};    // [m] half the footprint's width
+  double cell_size{0.5};     // [m] of the coarse grid (a multiple of the costmap's resolution)
+  double turning_room{3.0};  // [m]
+  double narrow_penalty{0.0};
+};
+
 class ObstacleHeuristic {
  public:
-  ObstacleHeuristic(const Costmap& costmap, double half_width, double cell_size, const Pose2& goal);
+  ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal);
 
   // Distance [m] from p (map frame) to the goal; +inf when the goal cannot be reached from p.
   double distance(const Pose2& p) const;

@@ -17,10 +17,11 @@
 // (1 + reverse_weight when reversing), plus direction_change_weight [m] when it changes the
 // direction of travel. Heuristic: distance_heuristic_weight * max(Reeds-Shepp distance to the goal
 // without obstacles, 8-connected Dijkstra distance from the goal over the cells the rear axle can
-// occupy), on a grid of lattice cells. Weights above 1 trade optimality for speed (the default
-// 2.0 is Autoware's; the heuristic ignores the cost weights, so with 1.0 the search floods every
-// state whose weighted detour is below the true cost's excess: 22/24 benchmark problems solved in
-// 2 s against 24/24, and 4x the median time).
+// occupy, on a grid of lattice cells). Weights above 1 trade optimality for speed: the default 2.0
+// is Autoware's; the heuristic ignores the cost weights, so with 1.0 the search floods every state
+// whose detour is below the true cost's excess (bench/RESULTS.md has the figures). The Dijkstra
+// distance also charges extra for narrow places (narrow_heuristic_penalty): gaps the rear axle
+// fits through but the vehicle cannot turn into otherwise draw the search in.
 //
 // The pose the search expands from is known to be free, with a clearance bound kept in its node:
 // the primitives from it are only checked beyond it.
@@ -57,6 +58,9 @@ struct HybridAStarConfig {
   double reverse_weight{1.0};
   double direction_change_weight{1.5};    // [m] added per change of driving direction
   double distance_heuristic_weight{2.0};  // Autoware start planner default
+  // The obstacle-aware distance charges up to (1 + this) per metre in places with less room than
+  // half the footprint's diagonal (see the note above); 0 = the plain distance.
+  double narrow_heuristic_penalty{3.0};
   // Goal region, in the goal frame: |longitudinal| <= longitudinal_goal_range / 2, ...
   double longitudinal_goal_range{2.0};  // [m]
   double lateral_goal_range{0.5};       // [m]
