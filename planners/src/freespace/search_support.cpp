@@ -138,7 +138,28 @@ double ObstacleHeuristic::distance(const Pose2& p) const {
   int j = 0;
   costmap_.cell_of({p.x, p.y}, i, j);
   if (!costmap_.inside(i, j)) return std::numeric_limits<double>::infinity();
-  return distance_[static_cast<std::size_t>(j / factor_) * width_ + (i / factor_)];
+  const int ci = i / factor_;
+  const int cj = j / factor_;
+  const double own = distance_[static_cast<std::size_t>(cj) * width_ + ci];
+  if (!std::isfinite(own)) return own;
+  // Bilinear between the four nearest cell centres, so that the value changes smoothly with the
+  // pose: a step of a whole cell's worth at cell borders would drown the cost differences of
+  // the primitives (a quarter metre and less) and let the search spread sideways.
+  const Vec2 g = costmap_.to_grid({p.x, p.y}) / static_cast<double>(factor_) - Vec2(0.5, 0.5);
+  const int x0 = std::clamp(static_cast<int>(std::floor(g.x())), 0, width_ - 2);
+  const int y0 = std::clamp(static_cast<int>(std::floor(g.y())), 0, height_ - 2);
+  if (width_ < 2 || height_ < 2) return own;
+  const double tx = std::clamp(g.x() - x0, 0.0, 1.0);
+  const double ty = std::clamp(g.y() - y0, 0.0, 1.0);
+  const auto at = [this](int x, int y) {
+    return static_cast<double>(distance_[static_cast<std::size_t>(y) * width_ + x]);
+  };
+  const double d00 = at(x0, y0);
+  const double d10 = at(x0 + 1, y0);
+  const double d01 = at(x0, y0 + 1);
+  const double d11 = at(x0 + 1, y0 + 1);
+  if (!std::isfinite(d00) || !std::isfinite(d10) || !std::isfinite(d01) || !std::isfinite(d11)) return own;
+  return (1.0 - ty) * ((1.0 - tx) * d00 + tx * d10) + ty * ((1.0 - tx) * d01 + tx * d11);
 }
 
 NodeTable::NodeTable() {
