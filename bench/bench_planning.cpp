@@ -43,6 +43,14 @@ void BM_Plan_FullSearch(benchmark::State& state) { plan_scenario(state, "full_se
 void BM_Plan_ParallelSpot(benchmark::State& state) { plan_scenario(state, "parallel_spot"); }
 void BM_Plan_PerpendicularBay(benchmark::State& state) { plan_scenario(state, "perpendicular_bay"); }
 void BM_Plan_CarCloseAhead(benchmark::State& state) { plan_scenario(state, "car_close_ahead"); }
+// The freespace fallback, whole pipeline: the lane-based search fails, then the costmap is built
+// from the lanes and objects, end poses are searched on the lane ahead, and hybrid A* runs.
+void BM_Plan_FreespaceBoxedIn(benchmark::State& state) { plan_scenario(state, "freespace_boxed_in"); }
+void BM_Plan_FreespacePerpendicularBay(benchmark::State& state) {
+  plan_scenario(state, "freespace_perpendicular_bay");
+}
+// A pure freespace problem: a grid and a goal pose, no lanes.
+void BM_Plan_FreespaceParkingLot(benchmark::State& state) { plan_scenario(state, "freespace_parking_lot"); }
 
 BENCHMARK(BM_Plan_StraightShoulder)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_StraightShoulder_AllMargins)->Unit(benchmark::kMicrosecond);
@@ -52,6 +60,9 @@ BENCHMARK(BM_Plan_FullSearch)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_ParallelSpot)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_PerpendicularBay)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_CarCloseAhead)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_FreespaceBoxedIn)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_FreespacePerpendicularBay)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_FreespaceParkingLot)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
