@@ -46,9 +46,7 @@ void BM_Plan_CarCloseAhead(benchmark::State& state) { plan_scenario(state, "car_
 // The freespace fallback, whole pipeline: the lane-based search fails, then the costmap is built
 // from the lanes and objects, end poses are searched on the lane ahead, and hybrid A* runs.
 void BM_Plan_FreespaceBoxedIn(benchmark::State& state) { plan_scenario(state, "freespace_boxed_in"); }
-void BM_Plan_FreespacePerpendicularBay(benchmark::State& state) {
-  plan_scenario(state, "freespace_perpendicular_bay");
-}
+void BM_Plan_FreespacePerpendicularBay(benchmark::State& state) { plan_scenario(state, "freespace_perpendicular_bay"); }
 // A pure freespace problem: a grid and a goal pose, no lanes.
 void BM_Plan_FreespaceParkingLot(benchmark::State& state) { plan_scenario(state, "freespace_parking_lot"); }
 

@@ -104,6 +104,29 @@ TEST(HybridAStar, TurningAroundInANarrowCorridorNeedsReversing) {
   EXPECT_GE(changes, 1);
 }
 
+TEST(HybridAStar, EveryPointOfThePathIsFreeNotOnlyTheTestedPoses) {
+  // Reversing into a 2.5 m bay between two parked cars (0.3 m each side of a 1.9 m car): the
+  // motion between tested poses is covered too. Waypoints every centimetre, each tested exactly.
+  const Costmap m = walled_map(24, 16, {box(6.5, 0.2, 8.4, 5.0), box(10.9, 0.2, 12.8, 5.0)});
+  const GridCollisionChecker checker(m, kCar);
+  HybridAStarConfig c = config();
+  c.waypoint_interval = 0.01;
+  const HybridAStar planner(checker, c);
+  const Pose2 start{4, 10, 0};
+  const Pose2 goal{9.65, 1.5, M_PI / 2};  // rear axle in the bay, nose to the aisle
+  const HybridAStarResult r = planner.plan(start, goal, Deadline::after_ms(5000));
+  ASSERT_EQ(r.status, HybridAStarResult::Status::kSuccess);
+  ASSERT_GT(r.waypoints.size(), 500u);
+  for (std::size_t i = 0; i < r.waypoints.size(); ++i) {
+    ASSERT_FALSE(checker.collides(r.waypoints[i].pose)) << "waypoint " << i << " of " << r.waypoints.size();
+    if (i > 0) {
+      const Pose2& a = r.waypoints[i - 1].pose;
+      const Pose2& b = r.waypoints[i].pose;
+      ASSERT_LE(std::hypot(b.x - a.x, b.y - a.y), 0.01 + 1e-9);
+    }
+  }
+}
+
 TEST(HybridAStar, TypedFailures) {
   const Costmap m = walled_map(30, 30, {box(14, 0, 15, 30)});  // a wall with no gap
   const GridCollisionChecker checker(m, kCar);

@@ -19,6 +19,7 @@ constexpr int kShotCandidates = 3;                  // Reeds-Shepp words tried p
 constexpr double kShotDistancePerInterval = 4.0;    // [m] heuristic distance per expansion between shots
 constexpr double kReedsSheppRange = 4.0;            // [turning radii] see heuristic()
 constexpr double kCoarseSpacing = 1.0;              // [m] first-pass sample spacing of a shot
+constexpr double kSweepGrowth = 0.5;                // [cells] footprint growth between tested poses
 
 double wrap(double a) {
   a = std::fmod(a + kTwoPi / 2.0, kTwoPi);
@@ -53,7 +54,9 @@ class Search {
         goal_(goal),
         rs_(config.turning_radius),
         weights_{config.curve_weight, config.reverse_weight, config.direction_change_weight},
-        heuristic_(costmap_, heuristic_config(checker, config), goal) {}
+        heuristic_(costmap_, heuristic_config(checker, config), goal),
+        swept_checker_(costmap_, grown(checker.footprint(), kSweepGrowth * costmap_.resolution())),
+        sweep_{checker_, swept_checker_, kSweepGrowth * costmap_.resolution()} {}
 
   HybridAStarResult run(const Deadline& deadline) {
     HybridAStarResult result;
@@ -199,7 +202,7 @@ class Search {
         const Pose2 child_pose = arc.at(distance, unused_c, unused_s);
         if (key(child_pose) == parent_key) continue;
         double clearance = 0.0;
-        if (!fd::arc_free(checker_, arc, parent.clearance, distance, clearance)) continue;
+        if (!fd::arc_free(sweep_, arc, parent.clearance, distance, clearance)) continue;
         double cost = length * (1.0 + config_.curve_weight * std::abs(steer) / steps);
         if (direction < 0) cost *= 1.0 + config_.reverse_weight;
         if (parent.direction != 0 && parent.direction != direction) cost += config_.direction_change_weight;
@@ -242,7 +245,7 @@ class Search {
         const ReedsSheppSegment& seg = p.segments[static_cast<std::size_t>(i)];
         if (std::abs(seg.length) < 1e-9) continue;
         const double k = static_cast<double>(static_cast<int>(seg.kind)) / config_.turning_radius;
-        const bool free = fine ? fd::arc_free(checker_, fd::Arc(pose, k), clearance, seg.length, clearance)
+        const bool free = fine ? fd::arc_free(sweep_, fd::Arc(pose, k), clearance, seg.length, clearance)
                                : fd::arc_samples_free(checker_, pose, k, seg.length, kCoarseSpacing);
         if (!free) return false;
         pose = fd::drive(pose, k, seg.length);
@@ -288,6 +291,14 @@ class Search {
     if (w.size() == 1) w.push_back(w.front());  // start already in the goal region: a zero-length path
   }
 
+  static Footprint grown(Footprint f, double by) {
+    f.front += by;
+    f.rear += by;
+    f.left += by;
+    f.right += by;
+    return f;
+  }
+
   const GridCollisionChecker& checker_;
   const Costmap& costmap_;
   const HybridAStarConfig& config_;
@@ -296,6 +307,8 @@ class Search {
   ReedsShepp rs_;
   ReedsSheppWeights weights_;
   fd::ObstacleHeuristic heuristic_;
+  GridCollisionChecker swept_checker_;  // the footprint grown for the motion between tested poses
+  fd::SweepCheckers sweep_;
   std::vector<Node> nodes_;
   fd::NodeTable table_;
   using OpenItem = std::pair<double, std::int32_t>;

@@ -34,27 +34,27 @@ Pose2 Arc::at(double distance, double& cos_yaw, double& sin_yaw) const {
   return {from_.x + r * (sin_yaw - sin_), from_.y + r * (cos_ - cos_yaw), yaw};
 }
 
-bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_clearance, double distance,
               double& end_clearance) {
   const double total = std::abs(distance);
   const double sign = distance < 0.0 ? -1.0 : 1.0;
-  const double factor = checker.sweep_factor(arc.curvature());
-  // Near obstacles, exact checks no more than half a cell of footprint motion apart.
-  const double min_step = 0.5 * checker.costmap().resolution() / factor;
-  // Nothing can be touched before the footprint has moved by its clearance.
-  double s = std::min(total, std::max(min_step, start_clearance / factor));
-  while (true) {
-    double c = 1.0;
-    double sn = 0.0;
+  const double factor = checkers.exact.sweep_factor(arc.curvature());
+  double c = 1.0;
+  double sn = 0.0;
+  // The end first: where the search stops, tested exactly (and the likeliest to collide).
+  const Pose2 end = arc.at(distance, c, sn);
+  if (checkers.exact.collides(end, c, sn, end_clearance)) return false;
+  double covered = start_clearance / factor;                    // [0, covered] is known free
+  const double uncovered_end = total - end_clearance / factor;  // so is [uncovered_end, total]
+  const double half_stretch = checkers.growth / factor;
+  while (covered < uncovered_end) {
+    const double s = std::min(covered + half_stretch, total);
     const Pose2 pose = arc.at(sign * s, c, sn);
     double clearance = 0.0;
-    if (checker.collides(pose, c, sn, clearance)) return false;
-    if (s >= total) {
-      end_clearance = clearance;
-      return true;
-    }
-    s = std::min(total, s + std::max(min_step, clearance / factor));
+    if (checkers.swept.collides(pose, c, sn, clearance)) return false;
+    covered = s + half_stretch + clearance / factor;
   }
+  return true;
 }
 
 bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance,

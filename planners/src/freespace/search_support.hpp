@@ -33,11 +33,25 @@ class Arc {
   double curvature_{0.0};
 };
 
-// True when the footprint stays clear of every occupied cell along the arc (see hybrid_astar.hpp
-// for the sampling rule), including its end. The start is known to be free with clearance lower
-// bound `start_clearance` [m] (0 when unknown beyond being free): it is not tested again.
-// `end_clearance` receives the end pose's clearance bound.
-bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+// The two collision tests of a swept footprint: `exact` for the poses where the search stops, and
+// `swept`, the same footprint grown by `growth` [m] on every side, for the motion in between.
+struct SweepCheckers {
+  const GridCollisionChecker& exact;
+  const GridCollisionChecker& swept;
+  double growth{0.0};
+};
+
+// True when the footprint stays clear of every occupied cell over the whole arc, the motion
+// between the poses tested included. The start is known to be free with clearance lower bound
+// `start_clearance` [m] (0 when unknown beyond being free) and is not tested again; the end is
+// tested with the exact footprint and `end_clearance` receives its clearance bound.
+//
+// In between, while the footprint drives a length l on the arc, no point of it moves farther than
+// sweep_factor * l, so over [s - u, s + u] (u = growth / sweep_factor) the body stays inside the
+// footprint at s grown by `growth`: one test of the grown footprint covers that stretch, and its
+// clearance bound c widens it by c / sweep_factor each way. The test is conservative (a sweep that
+// passes within `growth` of an occupied cell is refused), never optimistic.
+bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_clearance, double distance,
               double& end_clearance);
 
 // A quick necessary condition for arc_free: the poses every `spacing` [m] along the arc and its

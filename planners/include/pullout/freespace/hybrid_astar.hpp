@@ -26,10 +26,12 @@
 // The pose the search expands from is known to be free, with a clearance bound kept in its node:
 // the primitives from it are only checked beyond it.
 //
-// Collision: every pose checked is tested exactly against the costmap (GridCollisionChecker).
-// Along a primitive or a shot, the next pose checked is as far as the footprint's clearance bound
-// allows (the footprint cannot touch anything in between), and at most half a cell of footprint
-// motion when the footprint is within a cell of an obstacle.
+// Collision: the poses the search stops at (nodes, the goal) are tested exactly against the
+// costmap (GridCollisionChecker). The motion between them is covered completely, conservatively:
+// the footprint grown by half a cell, tested at poses spaced so that the body cannot leave the
+// grown rectangle in between (see arc_free in search_support.hpp); the clearance bound of a test
+// skips the stretch it proves free. So a returned path is collision-free at every point, not
+// only at its samples.
 //
 // Failure modes are values (Status), never exceptions. The deadline is checked between
 // expansions; the search returns kTimeout promptly after it expires.
