@@ -153,6 +153,7 @@ TEST(Config, ShippedConfigLoadsWithTheStructDefaults) {
   EXPECT_EQ(f.astar.use_back, g.astar.use_back);
   EXPECT_DOUBLE_EQ(f.astar.distance_heuristic_weight, g.astar.distance_heuristic_weight);
   EXPECT_DOUBLE_EQ(f.astar.expansion_distance, g.astar.expansion_distance);
+  EXPECT_DOUBLE_EQ(f.astar.narrow_heuristic_penalty, g.astar.narrow_heuristic_penalty);
 
   EXPECT_EQ(c.service.worker_threads, d.service.worker_threads);
   EXPECT_DOUBLE_EQ(c.service.default_deadline_ms, d.service.default_deadline_ms);
@@ -259,6 +260,7 @@ TEST(Config, ShippedConfigSetsEveryKey) {
                           "use_back",
                           "distance_heuristic_weight",
                           "expansion_distance",
+                          "narrow_heuristic_penalty",
                           "worker_threads",
                           "default_deadline_ms",
                           "log_level",

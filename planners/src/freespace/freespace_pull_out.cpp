@@ -47,6 +47,7 @@ HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const Free
   c.reverse_weight = p.search_configs.reverse_weight;
   c.direction_change_weight = p.search_configs.direction_change_weight;
   c.distance_heuristic_weight = p.astar.distance_heuristic_weight;
+  c.narrow_heuristic_penalty = p.astar.narrow_heuristic_penalty;
   c.longitudinal_goal_range = p.search_configs.longitudinal_goal_range;
   c.lateral_goal_range = p.search_configs.lateral_goal_range;
   c.angle_goal_range = p.search_configs.angle_goal_range * kDegToRad;

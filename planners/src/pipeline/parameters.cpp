@@ -259,6 +259,7 @@ std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p)
     c.in_range(cc + "resolution", f.costmap_configs.resolution, 0.02, 2.0);
     c.in_range(fp + "astar.distance_heuristic_weight", f.astar.distance_heuristic_weight, 0.1, 10.0);
     c.in_range(fp + "astar.expansion_distance", f.astar.expansion_distance, 0.05, 10.0);
+    c.in_range(fp + "astar.narrow_heuristic_penalty", f.astar.narrow_heuristic_penalty, 0.0, 100.0);
   }
   return issues;
 }

@@ -98,6 +98,7 @@ void read_freespace(MapReader& parent, FreespaceParameters& out) {
       a.read("use_back", out.astar.use_back);
       a.read("distance_heuristic_weight", out.astar.distance_heuristic_weight);
       a.read("expansion_distance", out.astar.expansion_distance);
+      a.read("narrow_heuristic_penalty", out.astar.narrow_heuristic_penalty);
       a.finish(&freespace_hint);
     }
   }

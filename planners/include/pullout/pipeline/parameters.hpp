@@ -43,6 +43,9 @@ struct FreespaceParameters {
     bool use_back{true};                    // reverse primitives
     double distance_heuristic_weight{2.0};  // > 1: faster, less optimal (Autoware default)
     double expansion_distance{0.5};         // [m] arc length of a motion primitive
+    // Not in Autoware: the obstacle-aware heuristic charges up to (1 + this) per metre through
+    // places narrower than the vehicle needs to turn (see hybrid_astar.hpp); 0 = plain distance.
+    double narrow_heuristic_penalty{3.0};
   } astar;
 };
 
