@@ -207,8 +207,7 @@ int Costmap::occupied_in_row(int iy, int c0, int c1) const {
     c1 = width_ - 1;
   }
   if (c1 < c0) return outside;
-  const std::int32_t* row = row_prefix_.data() + static_cast<std::size_t>(iy) * (width_ + 1);
-  return outside + row[c1 + 1] - row[c0];
+  return outside + occupied_in_box_inside(c0, iy, c1, iy);
 }
 
 long long Costmap::occupied_in_box(int c0, int r0, int c1, int r1) const {
@@ -225,15 +224,14 @@ long long Costmap::occupied_in_box(int c0, int r0, int c1, int r1) const {
 
 void Costmap::precompute() {
   const std::size_t stride = static_cast<std::size_t>(width_) + 1;
-  row_prefix_.assign(stride * static_cast<std::size_t>(height_), 0);
   box_prefix_.assign(stride * (static_cast<std::size_t>(height_) + 1), 0);
   for (int j = 0; j < height_; ++j) {
-    std::int32_t* row = row_prefix_.data() + static_cast<std::size_t>(j) * stride;
     const std::int32_t* below = box_prefix_.data() + static_cast<std::size_t>(j) * stride;
     std::int32_t* box = box_prefix_.data() + static_cast<std::size_t>(j + 1) * stride;
+    std::int32_t row = 0;  // occupied cells of row j left of column i + 1
     for (int i = 0; i < width_; ++i) {
-      row[i + 1] = row[i] + (occupied_[index(i, j)] != 0 ? 1 : 0);
-      box[i + 1] = below[i + 1] + row[i + 1];
+      row += occupied_[index(i, j)] != 0 ? 1 : 0;
+      box[i + 1] = below[i + 1] + row;
     }
   }
 

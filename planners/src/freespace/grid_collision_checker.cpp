@@ -32,7 +32,7 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
       double a = 0.0;
       double b = 0.0;
       if (!strip_extent(q, count, j, j + 1.0, a, b)) continue;
-      if (m.occupied_in_row_inside(j, std::max(0, cell_first(a)), cell_last(b)) > 0) return true;
+      if (m.occupied_in_box_inside(std::max(0, cell_first(a)), j, cell_last(b), j) > 0) return true;
     }
     return false;
   }
@@ -75,7 +75,8 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
     if (lo[k] > hi[k]) continue;
     // The cells the closed range [lo, hi] touches (a range ending on a cell boundary touches the
     // cell beyond it).
-    if (m.occupied_in_row_inside(j0 + r, std::max(0, cell_first(lo[k])), cell_last(hi[k])) > 0) return true;
+    const int j = j0 + r;
+    if (m.occupied_in_box_inside(std::max(0, cell_first(lo[k])), j, cell_last(hi[k]), j) > 0) return true;
   }
   return false;
 }
@@ -115,7 +116,9 @@ double GridCollisionChecker::sweep_factor(double curvature) const {
   const double k = std::abs(curvature);
   const double far_x = std::max(footprint_.front, footprint_.rear);
   const double far_y = std::max(footprint_.left, footprint_.right);
-  return std::hypot(1.0 + k * far_y, k * far_x);
+  const double a = 1.0 + k * far_y;
+  const double b = k * far_x;
+  return std::sqrt(a * a + b * b);
 }
 
 GridCollisionChecker::GridPose GridCollisionChecker::grid_pose(const Pose2& pose, double c, double s) const {

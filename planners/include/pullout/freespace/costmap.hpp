@@ -1,6 +1,6 @@
 // The costmap of the freespace planner: a binary occupancy grid with what the search needs
-// precomputed (row prefix sums and a summed-area table for exact footprint tests, a Euclidean
-// distance transform for cheap clearance bounds).
+// precomputed (a summed-area table for exact footprint tests, a Euclidean distance transform for
+// cheap clearance bounds).
 //
 // Frames: the grid frame G has its origin at the outer corner of cell (0, 0) and its axes along
 // the rows (+x, increasing column) and columns (+y, increasing row); X_MG = `origin` is its pose in
@@ -76,12 +76,6 @@ class Costmap {
   // Number of occupied cells in row iy between columns c0 and c1 (inclusive, clamped to the grid;
   // columns outside the grid count as occupied).
   int occupied_in_row(int iy, int c0, int c1) const;
-  // The same for columns 0 <= c0 <= c1 < width of a row 0 <= iy < height, without the clamping.
-  int occupied_in_row_inside(int iy, int c0, int c1) const {
-    const std::int32_t* row =
-        row_prefix_.data() + static_cast<std::size_t>(iy) * (static_cast<std::size_t>(width_) + 1);
-    return row[c1 + 1] - row[c0];
-  }
   // Number of occupied cells in the box of columns c0..c1 and rows r0..r1 (inclusive, clamped to
   // the grid; cells outside the grid count as occupied). O(1): four summed-area table lookups.
   long long occupied_in_box(int c0, int r0, int c1, int r1) const;
@@ -107,9 +101,9 @@ class Costmap {
   int width_{0};
   int height_{0};
   std::vector<std::uint8_t> occupied_;
-  std::vector<std::int32_t> row_prefix_;  // (width + 1) per row: occupied cells left of column c
-  std::vector<float> distance_;           // [m] see centre_distance
-  // Summed-area table, (width + 1) x (height + 1): occupied cells in columns < c and rows < r.
+  std::vector<float> distance_;  // [m] see centre_distance
+  // Summed-area table, (width + 1) x (height + 1): occupied cells in columns < c and rows < r (a
+  // row's count is the difference of two neighbouring table rows).
   std::vector<std::int32_t> box_prefix_;
 };
 

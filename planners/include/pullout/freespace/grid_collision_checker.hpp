@@ -5,7 +5,7 @@
 // point. It narrows down where to look with the costmap's summed-area table: no occupied cell in
 // the rectangle's axis-aligned bounding box means no collision; otherwise the rectangle is cut
 // into a few pieces, and only the pieces whose bounding box holds an occupied cell are cut into
-// the grid's row strips, each strip's exact column extent looked up in the row prefix sums. A
+// the grid's row strips, each strip's exact column extent counted in the same table. A
 // bound from the distance transform (the rectangle covered by a few discs) answers most queries
 // of collides(pose, bound) without the exact test.
 //
