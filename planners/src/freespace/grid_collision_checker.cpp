@@ -85,6 +85,8 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
 
 GridCollisionChecker::GridCollisionChecker(const Costmap& costmap, const Footprint& footprint)
     : costmap_(costmap), footprint_(footprint) {
+  origin_x_ = costmap.origin().x;
+  origin_y_ = costmap.origin().y;
   origin_cos_ = std::cos(costmap.origin().yaw);
   origin_sin_ = std::sin(costmap.origin().yaw);
   inv_resolution_ = 1.0 / costmap.resolution();
@@ -121,10 +123,10 @@ double GridCollisionChecker::sweep_factor(double curvature) const {
   return std::sqrt(a * a + b * b);
 }
 
-GridCollisionChecker::GridPose GridCollisionChecker::grid_pose(const Pose2& pose, double c, double s) const {
+inline GridCollisionChecker::GridPose GridCollisionChecker::grid_pose(const Pose2& pose, double c, double s) const {
   // Costmap::to_grid with the heading rotated along (X_GV = X_MG^-1 X_MV), cell units.
-  const double dx = pose.x - costmap_.origin().x;
-  const double dy = pose.y - costmap_.origin().y;
+  const double dx = pose.x - origin_x_;
+  const double dy = pose.y - origin_y_;
   return {(origin_cos_ * dx + origin_sin_ * dy) * inv_resolution_,
           (origin_cos_ * dy - origin_sin_ * dx) * inv_resolution_,
           (origin_cos_ * c + origin_sin_ * s) * inv_resolution_, (origin_cos_ * s - origin_sin_ * c) * inv_resolution_};
@@ -141,14 +143,12 @@ double GridCollisionChecker::clearance_bound(const Pose2& pose, double c, double
   const GridPose g = grid_pose(pose, c, s);
   const double res = costmap_.resolution();
   // Disc centres in the grid frame: the first one, then a constant step along the axis.
-  const double x0 = g.x + disc_first_x_ * g.ux - disc_offset_y_ * g.uy;
-  const double y0 = g.y + disc_first_x_ * g.uy + disc_offset_y_ * g.ux;
+  double px = g.x + disc_first_x_ * g.ux - disc_offset_y_ * g.uy;
+  double py = g.y + disc_first_x_ * g.uy + disc_offset_y_ * g.ux;
   const double step_x = disc_step_ * g.ux;
   const double step_y = disc_step_ * g.uy;
   double best = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < disc_count_; ++k) {
-    const double px = x0 + k * step_x;
-    const double py = y0 + k * step_y;
+  for (int k = 0; k < disc_count_; ++k, px += step_x, py += step_y) {
     // A centre outside the grid: the footprint leaves it (also catches NaN).
     if (!(px >= 0.0 && py >= 0.0 && px < grid_width_ && py < grid_height_)) return 0.0;
     const int ix = static_cast<int>(px);

@@ -52,6 +52,8 @@ class GridCollisionChecker {
   const Costmap& costmap_;
   Footprint footprint_;
   // The costmap's frame and size, kept here for the hot paths.
+  double origin_x_{0.0};
+  double origin_y_{0.0};
   double origin_cos_{1.0};
   double origin_sin_{0.0};
   double inv_resolution_{1.0};
