@@ -133,14 +133,13 @@ inline GridCollisionChecker::GridPose GridCollisionChecker::grid_pose(const Pose
 }
 
 double GridCollisionChecker::clearance_lower_bound(const Pose2& pose) const {
-  return clearance_bound(pose, std::cos(pose.yaw), std::sin(pose.yaw));
+  return clearance_bound(grid_pose(pose, std::cos(pose.yaw), std::sin(pose.yaw)));
 }
 
-double GridCollisionChecker::clearance_bound(const Pose2& pose, double c, double s) const {
+double GridCollisionChecker::clearance_bound(const GridPose& g) const {
   // For a disc centre p in cell k (centre q_k): every occupied square is at least
   // D(k) - |p - q_k| - res / sqrt2 away (D: centre distance to the nearest occupied centre; 0 on
   // an occupied cell), so the disc is at least that minus its radius away.
-  const GridPose g = grid_pose(pose, c, s);
   const double res = costmap_.resolution();
   // Disc centres in the grid frame: the first one, then a constant step along the axis.
   double px = g.x + disc_first_x_ * g.ux - disc_offset_y_ * g.uy;
@@ -173,13 +172,13 @@ bool GridCollisionChecker::collides(const Pose2& pose, double& bound) const {
 }
 
 bool GridCollisionChecker::collides(const Pose2& pose, double c, double s, double& bound) const {
-  bound = clearance_bound(pose, c, s);
+  const GridPose g = grid_pose(pose, c, s);
+  bound = clearance_bound(g);
   if (bound > 0.0) return false;
-  return collides_exact(pose, c, s);
+  return collides_exact(g);
 }
 
-bool GridCollisionChecker::collides_exact(const Pose2& pose, double c, double s) const {
-  const GridPose g = grid_pose(pose, c, s);
+bool GridCollisionChecker::collides_exact(const GridPose& g) const {
   const Footprint& f = footprint_;
   // The rectangle cut into pieces_x_ x pieces_y_ equal pieces: lattice offsets from the rear axle
   // along the axis (a_i * u) and across it (b_k * v, v = u turned left), grid frame. The outer

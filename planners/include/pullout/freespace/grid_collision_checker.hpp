@@ -46,8 +46,8 @@ class GridCollisionChecker {
     double x, y, ux, uy;
   };
   GridPose grid_pose(const Pose2& pose, double c, double s) const;
-  double clearance_bound(const Pose2& pose, double c, double s) const;
-  bool collides_exact(const Pose2& pose, double c, double s) const;
+  double clearance_bound(const GridPose& g) const;
+  bool collides_exact(const GridPose& g) const;
 
   const Costmap& costmap_;
   Footprint footprint_;
