@@ -10,7 +10,6 @@ namespace pullout {
 namespace {
 
 constexpr double kInvSqrt2 = 0.70710678118654752440;
-constexpr double kSqrt2Minus1 = 0.41421356237309504880;
 constexpr int kMaxRows = 256;         // rows of a piece handled on the stack; beyond: strip by strip
 constexpr int kMaxPieces = 8;         // pieces along each side of the rectangle at most
 constexpr double kPieceCells = 12.0;  // [cells] the pieces' target side
@@ -154,8 +153,7 @@ double GridCollisionChecker::clearance_bound(const GridPose& g) const {
     const int iy = static_cast<int>(py);
     const double ox = std::abs(px - ix - 0.5);
     const double oy = std::abs(py - iy - 0.5);
-    // |p - q_k| <= max + (sqrt2 - 1) min: the chord above the convex hypot(max, t), t in [0, max].
-    const double off = (std::max(ox, oy) + kSqrt2Minus1 * std::min(ox, oy)) * res;
+    const double off = std::sqrt(ox * ox + oy * oy) * res;
     best = std::min(best, costmap_.centre_distance(ix, iy) - off);
     if (best <= bound_margin_) return 0.0;
   }
