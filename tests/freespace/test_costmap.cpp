@@ -259,6 +259,11 @@ TEST(Costmap, OccupiedInBoxMatchesBruteForce) {
       for (int i = c0; i <= c1; ++i) expected += m.occupied(i, j) ? 1 : 0;
     }
     ASSERT_EQ(m.occupied_in_box(c0, r0, c1, r1), expected) << c0 << " " << r0 << " " << c1 << " " << r1;
+    if (c0 <= c1) {
+      long long in_row = 0;
+      for (int i = c0; i <= c1; ++i) in_row += m.occupied(i, r0) ? 1 : 0;
+      ASSERT_EQ(m.occupied_in_row(r0, c0, c1), in_row) << r0 << " " << c0 << " " << c1;
+    }
   }
 }
 
@@ -310,6 +315,29 @@ TEST(GridCollisionChecker, AgreesWithReferenceNearObstaclesAndBoundIsALowerBound
   EXPECT_GT(hits, total / 5);
   EXPECT_LT(hits, total * 4 / 5);
   EXPECT_GT(positive_bounds, total / 20);
+}
+
+// A footprint of hundreds of cells a side: its pieces span more rows than the checker keeps on
+// the stack (at 5 mm cells, 2.6 m x 1.8 m in 8 x 8 pieces of 65 x 45 cells, ~78 rows at 45 deg).
+TEST(GridCollisionChecker, AgreesWithReferenceForAHugeFootprintOnAFineGrid) {
+  std::mt19937 rng(99);
+  std::vector<std::pair<int, int>> cells;
+  const Costmap m = random_map(rng, 1000, 1000, 0.005, {0.3, -0.2, 0.4}, cells, 5);
+  const Footprint fp{2.0, 0.6, 0.9, 0.9};
+  const GridCollisionChecker checker(m, fp);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), yaw(-M_PI, M_PI);
+  int hits = 0;
+  for (int n = 0; n < 300; ++n) {
+    const Vec2 p = m.to_map({500.0 + 40.0 * u(rng), 500.0 + 40.0 * u(rng)});
+    const Pose2 pose{p.x(), p.y(), yaw(rng)};
+    const Reference ref = reference(m, cells, fp, pose);
+    ASSERT_EQ(checker.collides(pose), ref.collides) << pose.x << " " << pose.y << " " << pose.yaw;
+    ASSERT_LE(checker.clearance_lower_bound(pose), ref.distance);
+    hits += ref.collides ? 1 : 0;
+  }
+  std::printf("%d of 300 poses collide\n", hits);
+  EXPECT_GT(hits, 30);
+  EXPECT_LT(hits, 270);
 }
 
 // Axis-aligned poses (yaw 0, pi/2, pi, -pi/2 with exact cos/sin) on a lattice of 1/16 m around a

@@ -195,20 +195,7 @@ double Costmap::clearance_lower_bound(const Vec2& p_M) const {
   return std::max(0.0, static_cast<double>(distance_[index(ix, iy)]) - kSqrt2 * resolution_);
 }
 
-int Costmap::occupied_in_row(int iy, int c0, int c1) const {
-  if (iy < 0 || iy >= height_) return c1 - c0 + 1;
-  int outside = 0;
-  if (c0 < 0) {
-    outside += -c0;
-    c0 = 0;
-  }
-  if (c1 >= width_) {
-    outside += c1 - width_ + 1;
-    c1 = width_ - 1;
-  }
-  if (c1 < c0) return outside;
-  return outside + occupied_in_box_inside(c0, iy, c1, iy);
-}
+int Costmap::occupied_in_row(int iy, int c0, int c1) const { return static_cast<int>(occupied_in_box(c0, iy, c1, iy)); }
 
 long long Costmap::occupied_in_box(int c0, int r0, int c1, int r1) const {
   if (c1 < c0 || r1 < r0) return 0;

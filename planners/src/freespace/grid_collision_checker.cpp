@@ -4,13 +4,14 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace pullout {
 
 namespace {
 
 constexpr double kInvSqrt2 = 0.70710678118654752440;
-constexpr int kMaxRows = 256;         // rows of a piece handled on the stack; beyond: strip by strip
+constexpr int kMaxRows = 64;          // rows of a piece kept on the stack (pieces have ~20)
 constexpr int kMaxPieces = 8;         // pieces along each side of the rectangle at most
 constexpr double kPieceCells = 12.0;  // [cells] the pieces' target side
 
@@ -26,22 +27,19 @@ inline int cell_first(double v) {
 // cell units, inside the grid) in the rows j0..j1, which cover the rows its y extent touches.
 bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, int j1) {
   const int rows = j1 - j0 + 1;
-  if (rows > kMaxRows) {
-    for (int j = j0; j <= j1; ++j) {
-      double a = 0.0;
-      double b = 0.0;
-      if (!strip_extent(q, count, j, j + 1.0, a, b)) continue;
-      if (m.occupied_in_box_inside(std::max(0, cell_first(a)), j, cell_last(b), j) > 0) return true;
-    }
-    return false;
-  }
   // Each edge adds its exact x range within every row strip it crosses; a convex polygon's extent
   // in a strip is the union of its edges' ranges there (a strip that cuts the polygon cuts its
-  // boundary on both sides).
-  std::array<double, kMaxRows> lo;
-  std::array<double, kMaxRows> hi;
-  std::fill_n(lo.begin(), rows, std::numeric_limits<double>::infinity());
-  std::fill_n(hi.begin(), rows, -std::numeric_limits<double>::infinity());
+  // boundary on both sides). The ranges live on the stack unless the piece is unusually tall.
+  std::array<double, 2 * kMaxRows> stack;
+  std::vector<double> heap;
+  double* lo = stack.data();
+  if (rows > kMaxRows) {
+    heap.resize(2 * static_cast<std::size_t>(rows));
+    lo = heap.data();
+  }
+  double* hi = lo + rows;
+  std::fill_n(lo, rows, std::numeric_limits<double>::infinity());
+  std::fill_n(hi, rows, -std::numeric_limits<double>::infinity());
   const auto add = [&](int j, double xa, double xb) {
     if (j < j0 || j > j1) return;
     const auto r = static_cast<std::size_t>(j - j0);
