@@ -134,6 +134,21 @@ void BM_ClearanceBound(benchmark::State& state, bool near) {
   state.counters["positive"] = static_cast<double>(positive) / static_cast<double>(state.iterations());
 }
 
+// The costmap's precomputation (distance transform, summed-area table) for one lot: the price
+// paid once per planning request.
+void BM_CostmapBuild(benchmark::State& state) {
+  const Lot& l = lot(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const pullout::Costmap& m = l.costmap;
+  std::vector<std::uint8_t> occ(static_cast<std::size_t>(m.width()) * m.height());
+  for (int j = 0; j < m.height(); ++j) {
+    for (int i = 0; i < m.width(); ++i) occ[static_cast<std::size_t>(j) * m.width() + i] = m.occupied(i, j) ? 1 : 0;
+  }
+  for (auto _ : state) {
+    const pullout::Costmap built(m.origin(), m.resolution(), m.width(), m.height(), occ);
+    benchmark::DoNotOptimize(built.centre_distance(0, 0));
+  }
+}
+
 // Lot size [m] x resolution [cm].
 void lots(benchmark::internal::Benchmark* b) {
   for (const int size : {30, 100}) {
@@ -145,6 +160,7 @@ BENCHMARK_CAPTURE(BM_Collides, near, true)->Apply(lots);
 BENCHMARK_CAPTURE(BM_Collides, open, false)->Apply(lots);
 BENCHMARK_CAPTURE(BM_ClearanceBound, near, true)->Apply(lots);
 BENCHMARK_CAPTURE(BM_ClearanceBound, open, false)->Apply(lots);
+BENCHMARK(BM_CostmapBuild)->Apply(lots)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
