@@ -74,10 +74,11 @@ class Costmap {
   double clearance_lower_bound(const Vec2& p_M) const;
 
   // Number of occupied cells in row iy between columns c0 and c1 (inclusive, clamped to the grid;
-  // columns outside the grid count as occupied).
+  // columns outside the grid count as occupied; 0 when c1 < c0).
   int occupied_in_row(int iy, int c0, int c1) const;
   // Number of occupied cells in the box of columns c0..c1 and rows r0..r1 (inclusive, clamped to
-  // the grid; cells outside the grid count as occupied). O(1): four summed-area table lookups.
+  // the grid; cells outside the grid count as occupied; 0 for an empty range). O(1): four
+  // summed-area table lookups.
   long long occupied_in_box(int c0, int r0, int c1, int r1) const;
   // The same for a non-empty box inside the grid (0 <= c0 <= c1 < width, 0 <= r0 <= r1 < height),
   // without the clamping: the collision checker's hot path.
