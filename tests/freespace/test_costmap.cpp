@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <random>
 
 #include "pullout/freespace/grid_collision_checker.hpp"
@@ -170,6 +173,233 @@ TEST(GridCollisionChecker, AgreesWithSeparatingAxesOnRandomPoses) {
   }
   EXPECT_GT(hits, 100);
   EXPECT_LT(hits, 2900);
+}
+
+// --- Randomised property tests against slow, obviously correct references -----------------------
+
+// A costmap of w x h cells with clusters of occupied cells (random blocks and single cells).
+Costmap random_map(std::mt19937& rng, int w, int h, double res, const Pose2& origin,
+                   std::vector<std::pair<int, int>>& cells, int clusters = 25) {
+  std::vector<std::uint8_t> occ(static_cast<std::size_t>(w * h), 0);
+  std::uniform_int_distribution<int> xi(0, w - 1), yi(0, h - 1), size(1, 6);
+  for (int k = 0; k < clusters; ++k) {
+    const int i0 = xi(rng), j0 = yi(rng);
+    const int sw = k % 3 == 0 ? 1 : size(rng), sh = k % 3 == 0 ? 1 : size(rng);
+    for (int j = j0; j < std::min(h, j0 + sh); ++j) {
+      for (int i = i0; i < std::min(w, i0 + sw); ++i) occ[static_cast<std::size_t>(j * w + i)] = 1;
+    }
+  }
+  cells.clear();
+  for (int j = 0; j < h; ++j) {
+    for (int i = 0; i < w; ++i) {
+      if (occ[static_cast<std::size_t>(j * w + i)] != 0) cells.emplace_back(i, j);
+    }
+  }
+  return Costmap(origin, res, w, h, std::move(occ));
+}
+
+// Distance between the closed convex polygons a and b (0 when they meet; the caller knows): the
+// nearest points of two disjoint convex polygons include a vertex of one of them.
+double polygon_distance(const std::array<Vec2, 4>& a, const std::array<Vec2, 4>& b) {
+  const auto point_segment = [](const Vec2& p, const Vec2& s0, const Vec2& s1) {
+    const Vec2 d = s1 - s0;
+    const double t = std::clamp((p - s0).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    return (p - (s0 + t * d)).norm();
+  };
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < 4; ++i) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      best = std::min(best, point_segment(a[i], b[k], b[(k + 1) % 4]));
+      best = std::min(best, point_segment(b[i], a[k], a[(k + 1) % 4]));
+    }
+  }
+  return best;
+}
+
+// The reference, in the grid frame (cell units): the footprint's map-frame corners mapped with
+// Costmap::to_grid, the outside-the-grid rule, then a separating-axis test against every occupied
+// cell square. Also the true distance [m] to the nearest occupied square or the grid's outside.
+struct Reference {
+  bool collides{false};
+  double distance{0.0};
+};
+Reference reference(const Costmap& m, const std::vector<std::pair<int, int>>& cells, const Footprint& fp,
+                    const Pose2& pose) {
+  std::array<Vec2, 4> g;
+  const auto c = footprint_corners(fp, pose);
+  for (std::size_t i = 0; i < 4; ++i) g[i] = m.to_grid(c[i]);
+  Reference r;
+  r.distance = std::numeric_limits<double>::infinity();
+  for (const Vec2& p : g) {
+    r.collides = r.collides || p.x() < 0 || p.y() < 0 || p.x() >= m.width() || p.y() >= m.height();
+    r.distance = std::min({r.distance, p.x(), p.y(), m.width() - p.x(), m.height() - p.y()});
+  }
+  for (const auto& [i, j] : cells) {
+    const double x0 = i, y0 = j, x1 = i + 1.0, y1 = j + 1.0;
+    if (rectangle_meets_square(g, x0, y0, x1, y1)) {
+      r.collides = true;
+      r.distance = 0.0;
+      break;
+    }
+    r.distance = std::min(r.distance, polygon_distance(g, {Vec2{x0, y0}, Vec2{x1, y0}, Vec2{x1, y1}, Vec2{x0, y1}}));
+  }
+  r.distance = r.collides ? 0.0 : r.distance * m.resolution();
+  return r;
+}
+
+TEST(Costmap, OccupiedInBoxMatchesBruteForce) {
+  std::mt19937 rng(3);
+  std::vector<std::pair<int, int>> cells;
+  const Costmap m = random_map(rng, 31, 17, 0.1, {}, cells);
+  std::uniform_int_distribution<int> xi(-3, 33), yi(-3, 19);
+  for (int n = 0; n < 2000; ++n) {
+    const int c0 = xi(rng), c1 = xi(rng), r0 = yi(rng), r1 = yi(rng);
+    long long expected = 0;
+    for (int j = r0; j <= r1; ++j) {
+      for (int i = c0; i <= c1; ++i) expected += m.occupied(i, j) ? 1 : 0;
+    }
+    ASSERT_EQ(m.occupied_in_box(c0, r0, c1, r1), expected) << c0 << " " << r0 << " " << c1 << " " << r1;
+    if (c0 <= c1) {
+      long long in_row = 0;
+      for (int i = c0; i <= c1; ++i) in_row += m.occupied(i, r0) ? 1 : 0;
+      ASSERT_EQ(m.occupied_in_row(r0, c0, c1), in_row) << r0 << " " << c0 << " " << c1;
+    }
+  }
+}
+
+// Random poses near obstacles (the rear axle within a footprint length of an occupied cell), on
+// maps with and without a turned origin, at two resolutions and for a long and a square footprint:
+// collides() agrees with the reference, and the clearance bound never exceeds the true distance.
+TEST(GridCollisionChecker, AgreesWithReferenceNearObstaclesAndBoundIsALowerBound) {
+  struct Case {
+    double res;
+    Pose2 origin;
+    Footprint fp;
+  };
+  const std::vector<Case> cases{{0.1, {}, {3.9, 1.1, 0.95, 0.95}},
+                                {0.2, {}, {3.9, 1.1, 0.95, 0.95}},
+                                {0.15, {3.0, -2.0, 0.7}, {2.0, 0.6, 0.5, 0.7}},
+                                {0.1, {-1.5, 4.0, -2.3}, {3.9, 1.1, 0.95, 0.95}},
+                                {0.25, {0.5, 0.25, 0.0}, {0.6, 0.6, 0.6, 0.6}}};
+  std::mt19937 rng(2024);
+  int hits = 0;
+  int total = 0;
+  int positive_bounds = 0;
+  for (const Case& cs : cases) {
+    std::vector<std::pair<int, int>> cells;
+    const Costmap m = random_map(rng, 200, 160, cs.res, cs.origin, cells, 60);
+    const GridCollisionChecker checker(m, cs.fp);
+    std::uniform_int_distribution<std::size_t> pick(0, cells.size() - 1);
+    std::uniform_real_distribution<double> off(-1.0, 1.0), yaw(-M_PI, M_PI);
+    const double reach = 1.5 * cs.fp.length() + 1.0;
+    for (int n = 0; n < 3000; ++n) {
+      const auto [ci, cj] = cells[pick(rng)];
+      const Vec2 centre = m.to_map({ci + 0.5, cj + 0.5});
+      const Pose2 pose{centre.x() + reach * off(rng), centre.y() + reach * off(rng), yaw(rng)};
+      const Reference ref = reference(m, cells, cs.fp, pose);
+      double bound = -1.0;
+      ASSERT_EQ(checker.collides(pose, bound), ref.collides)
+          << pose.x << " " << pose.y << " " << pose.yaw << " res " << cs.res;
+      ASSERT_EQ(checker.collides(pose), ref.collides);
+      const double lower = checker.clearance_lower_bound(pose);
+      ASSERT_GE(lower, 0.0);
+      ASSERT_LE(lower, ref.distance) << pose.x << " " << pose.y << " " << pose.yaw << " res " << cs.res;
+      ASSERT_LE(bound, ref.distance);
+      hits += ref.collides ? 1 : 0;
+      positive_bounds += lower > 0.0 ? 1 : 0;
+      ++total;
+    }
+  }
+  std::printf("%d of %d poses collide, %d positive bounds\n", hits, total, positive_bounds);
+  // Both outcomes well represented, and the bound is not trivially 0.
+  EXPECT_GT(hits, total / 5);
+  EXPECT_LT(hits, total * 4 / 5);
+  EXPECT_GT(positive_bounds, total / 20);
+}
+
+// A footprint of hundreds of cells a side: its pieces span more rows than the checker keeps on
+// the stack (at 5 mm cells, 2.6 m x 1.8 m in 8 x 8 pieces of 65 x 45 cells, ~78 rows at 45 deg).
+TEST(GridCollisionChecker, AgreesWithReferenceForAHugeFootprintOnAFineGrid) {
+  std::mt19937 rng(99);
+  std::vector<std::pair<int, int>> cells;
+  const Costmap m = random_map(rng, 1000, 1000, 0.005, {0.3, -0.2, 0.4}, cells, 5);
+  const Footprint fp{2.0, 0.6, 0.9, 0.9};
+  const GridCollisionChecker checker(m, fp);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), yaw(-M_PI, M_PI);
+  int hits = 0;
+  for (int n = 0; n < 300; ++n) {
+    const Vec2 p = m.to_map({500.0 + 40.0 * u(rng), 500.0 + 40.0 * u(rng)});
+    const Pose2 pose{p.x(), p.y(), yaw(rng)};
+    const Reference ref = reference(m, cells, fp, pose);
+    ASSERT_EQ(checker.collides(pose), ref.collides) << pose.x << " " << pose.y << " " << pose.yaw;
+    ASSERT_LE(checker.clearance_lower_bound(pose), ref.distance);
+    hits += ref.collides ? 1 : 0;
+  }
+  std::printf("%d of 300 poses collide\n", hits);
+  EXPECT_GT(hits, 30);
+  EXPECT_LT(hits, 270);
+}
+
+// Axis-aligned poses (yaw 0, pi/2, pi, -pi/2 with exact cos/sin) on a lattice of 1/16 m around a
+// few cells of 0.25 m: every value is exact in binary, so the rectangle's edges lie exactly on
+// cell boundaries (and corners on cell corners) at many poses. Touching is a collision, touching
+// the grid's far edges leaves the grid, touching its near edges does not.
+TEST(GridCollisionChecker, ExactWhenEdgesLieOnCellBoundaries) {
+  const double res = 0.25;
+  const int w = 24;
+  const int h = 20;
+  const Pose2 origin{-2.0, 1.5, 0.0};
+  const std::vector<std::pair<int, int>> cells{{9, 7}, {10, 7}, {14, 12}, {4, 15}};
+  std::vector<std::uint8_t> occ(static_cast<std::size_t>(w * h), 0);
+  for (const auto& [i, j] : cells) occ[static_cast<std::size_t>(j * w + i)] = 1;
+  const Costmap m(origin, res, w, h, std::move(occ));
+  const Footprint fp{1.5, 0.5, 0.75, 0.25};  // asymmetric: every side lands somewhere else
+  const GridCollisionChecker checker(m, fp);
+  struct Heading {
+    double yaw, c, s;
+  };
+  const Heading headings[] = {{0.0, 1.0, 0.0}, {M_PI / 2, 0.0, 1.0}, {M_PI, -1.0, 0.0}, {-M_PI / 2, 0.0, -1.0}};
+  int touching = 0;
+  int collisions = 0;
+  for (const Heading& hd : headings) {
+    for (int a = -8; a <= 16 * w * res + 8; ++a) {
+      for (int b = -8; b <= 16 * h * res + 8; ++b) {
+        const Pose2 pose{origin.x + a / 16.0, origin.y + b / 16.0, hd.yaw};
+        // The rectangle's x and y extents in the grid frame [cells], exactly.
+        const double gx = a / 16.0 / res;
+        const double gy = b / 16.0 / res;
+        const double lx0 = -fp.rear / res, lx1 = fp.front / res, ly0 = -fp.right / res, ly1 = fp.left / res;
+        double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+        if (hd.c > 0.5) {
+          x0 = gx + lx0, x1 = gx + lx1, y0 = gy + ly0, y1 = gy + ly1;
+        } else if (hd.s > 0.5) {
+          x0 = gx - ly1, x1 = gx - ly0, y0 = gy + lx0, y1 = gy + lx1;
+        } else if (hd.c < -0.5) {
+          x0 = gx - lx1, x1 = gx - lx0, y0 = gy - ly1, y1 = gy - ly0;
+        } else {
+          x0 = gx + ly0, x1 = gx + ly1, y0 = gy - lx1, y1 = gy - lx0;
+        }
+        bool expected = x0 < 0 || y0 < 0 || x1 >= w || y1 >= h;
+        for (const auto& [i, j] : cells) {
+          const bool meets = x0 <= i + 1 && i <= x1 && y0 <= j + 1 && j <= y1;  // closed boxes
+          expected = expected || meets;
+          touching += meets && (x0 == i + 1 || x1 == i || y0 == j + 1 || y1 == j) ? 1 : 0;
+        }
+        double bound = -1.0;
+        ASSERT_EQ(checker.collides(pose, hd.c, hd.s, bound), expected)
+            << "yaw " << hd.yaw << " grid rectangle [" << x0 << ", " << x1 << "] x [" << y0 << ", " << y1 << "]";
+        if (hd.yaw == 0.0) {
+          ASSERT_EQ(checker.collides(pose), expected);
+        }
+        if (expected) {
+          ASSERT_EQ(bound, 0.0);
+        }
+        collisions += expected ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(touching, 100);  // the lattice does hit the exact touches
+  EXPECT_GT(collisions, 1000);
 }
 
 }  // namespace

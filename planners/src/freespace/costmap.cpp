@@ -195,27 +195,31 @@ double Costmap::clearance_lower_bound(const Vec2& p_M) const {
   return std::max(0.0, static_cast<double>(distance_[index(ix, iy)]) - kSqrt2 * resolution_);
 }
 
-int Costmap::occupied_in_row(int iy, int c0, int c1) const {
-  if (iy < 0 || iy >= height_) return c1 - c0 + 1;
-  int outside = 0;
-  if (c0 < 0) {
-    outside += -c0;
-    c0 = 0;
-  }
-  if (c1 >= width_) {
-    outside += c1 - width_ + 1;
-    c1 = width_ - 1;
-  }
-  if (c1 < c0) return outside;
-  const std::int32_t* row = row_prefix_.data() + static_cast<std::size_t>(iy) * (width_ + 1);
-  return outside + row[c1 + 1] - row[c0];
+int Costmap::occupied_in_row(int iy, int c0, int c1) const { return static_cast<int>(occupied_in_box(c0, iy, c1, iy)); }
+
+long long Costmap::occupied_in_box(int c0, int r0, int c1, int r1) const {
+  if (c1 < c0 || r1 < r0) return 0;
+  const long long area = (static_cast<long long>(c1) - c0 + 1) * (static_cast<long long>(r1) - r0 + 1);
+  const int ic0 = std::max(c0, 0);
+  const int ir0 = std::max(r0, 0);
+  const int ic1 = std::min(c1, width_ - 1);
+  const int ir1 = std::min(r1, height_ - 1);
+  if (ic1 < ic0 || ir1 < ir0) return area;  // entirely outside
+  const long long inside = (static_cast<long long>(ic1) - ic0 + 1) * (static_cast<long long>(ir1) - ir0 + 1);
+  return area - inside + occupied_in_box_inside(ic0, ir0, ic1, ir1);
 }
 
 void Costmap::precompute() {
-  row_prefix_.assign(static_cast<std::size_t>(width_ + 1) * static_cast<std::size_t>(height_), 0);
+  const std::size_t stride = static_cast<std::size_t>(width_) + 1;
+  box_prefix_.assign(stride * (static_cast<std::size_t>(height_) + 1), 0);
   for (int j = 0; j < height_; ++j) {
-    std::int32_t* row = row_prefix_.data() + static_cast<std::size_t>(j) * (width_ + 1);
-    for (int i = 0; i < width_; ++i) row[i + 1] = row[i] + (occupied_[index(i, j)] != 0 ? 1 : 0);
+    const std::int32_t* below = box_prefix_.data() + static_cast<std::size_t>(j) * stride;
+    std::int32_t* box = box_prefix_.data() + static_cast<std::size_t>(j + 1) * stride;
+    std::int32_t row = 0;  // occupied cells of row j left of column i + 1
+    for (int i = 0; i < width_; ++i) {
+      row += occupied_[index(i, j)] != 0 ? 1 : 0;
+      box[i + 1] = below[i + 1] + row;
+    }
   }
 
   // Squared distance transform on the grid padded by one occupied cell on every side.

@@ -4,27 +4,110 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace pullout {
 
 namespace {
 
 constexpr double kInvSqrt2 = 0.70710678118654752440;
-constexpr int kMaxRows = 512;  // rows of a footprint handled on the stack; beyond: strip by strip
+constexpr int kMaxRows = 64;          // rows of a piece kept on the stack (pieces have ~20)
+constexpr int kMaxPieces = 8;         // pieces along each side of the rectangle at most
+constexpr double kPieceCells = 12.0;  // [cells] the pieces' target side
+
+// The cells whose closed interval [i, i + 1] contains the grid coordinate v >= 0 (inside the grid,
+// so truncation is floor): from cell_first(v) to cell_last(v); two cells when v is an integer.
+inline int cell_last(double v) { return static_cast<int>(v); }
+inline int cell_first(double v) {
+  const int i = static_cast<int>(v);
+  return static_cast<double>(i) == v ? i - 1 : i;
+}
+
+// True when an occupied cell meets the convex polygon q (count vertices in order, grid frame in
+// cell units, inside the grid) in the rows j0..j1, which cover the rows its y extent touches.
+bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, int j1) {
+  const int rows = j1 - j0 + 1;
+  // Each edge adds its exact x range within every row strip it crosses; a convex polygon's extent
+  // in a strip is the union of its edges' ranges there (a strip that cuts the polygon cuts its
+  // boundary on both sides). The ranges live on the stack unless the piece is unusually tall.
+  std::array<double, 2 * kMaxRows> stack;
+  std::vector<double> heap;
+  double* lo = stack.data();
+  if (rows > kMaxRows) {
+    heap.resize(2 * static_cast<std::size_t>(rows));
+    lo = heap.data();
+  }
+  double* hi = lo + rows;
+  std::fill_n(lo, rows, std::numeric_limits<double>::infinity());
+  std::fill_n(hi, rows, -std::numeric_limits<double>::infinity());
+  const auto add = [&](int j, double xa, double xb) {
+    if (j < j0 || j > j1) return;
+    const auto r = static_cast<std::size_t>(j - j0);
+    lo[r] = std::min(lo[r], std::min(xa, xb));
+    hi[r] = std::max(hi[r], std::max(xa, xb));
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    const Vec2& a = q[i];
+    const Vec2& b = q[i + 1 == count ? 0 : i + 1];
+    const double ya = std::min(a.y(), b.y());
+    const double yb = std::max(a.y(), b.y());
+    const int ja = cell_last(ya);
+    const int jb = cell_last(yb);
+    const bool on_boundary = static_cast<double>(ja) == ya;  // then the edge touches row ja - 1 too
+    if (yb == ya) {
+      add(ja, a.x(), b.x());
+      if (on_boundary) add(ja - 1, a.x(), b.x());
+      continue;
+    }
+    const double slope = (b.x() - a.x()) / (b.y() - a.y());
+    for (int j = ja; j <= jb; ++j) {
+      const double y0 = std::max(ya, static_cast<double>(j));
+      const double y1 = std::min(yb, j + 1.0);
+      add(j, a.x() + (y0 - a.y()) * slope, a.x() + (y1 - a.y()) * slope);
+    }
+    if (on_boundary) add(ja - 1, a.x() + (ya - a.y()) * slope, a.x() + (ya - a.y()) * slope);
+  }
+  for (int r = 0; r < rows; ++r) {
+    const auto k = static_cast<std::size_t>(r);
+    if (lo[k] > hi[k]) continue;
+    // The cells the closed range [lo, hi] touches (a range ending on a cell boundary touches the
+    // cell beyond it).
+    const int j = j0 + r;
+    if (m.occupied_in_box_inside(std::max(0, cell_first(lo[k])), j, cell_last(hi[k]), j) > 0) return true;
+  }
+  return false;
+}
 
 }  // namespace
 
 GridCollisionChecker::GridCollisionChecker(const Costmap& costmap, const Footprint& footprint)
     : costmap_(costmap), footprint_(footprint) {
+  origin_x_ = costmap.origin().x;
+  origin_y_ = costmap.origin().y;
+  origin_cos_ = std::cos(costmap.origin().yaw);
+  origin_sin_ = std::sin(costmap.origin().yaw);
+  inv_resolution_ = 1.0 / costmap.resolution();
+  grid_width_ = costmap.width();
+  grid_height_ = costmap.height();
   // Discs of radius r along the centre line cover the rectangle when each covers a slice of
   // length 2 * sqrt(r^2 - half_width^2). Slices of about 0.4 widths keep r within ~8 % of the
   // half width.
   const double half_width = 0.5 * footprint.width();
   const int n = std::max(1, static_cast<int>(std::ceil(2.5 * footprint.length() / std::max(footprint.width(), 1e-3))));
   const double slice = footprint.length() / n;
+  disc_count_ = n;
+  disc_first_x_ = -footprint.rear + 0.5 * slice;
+  disc_step_ = slice;
   disc_radius_ = std::hypot(0.5 * slice, half_width);
-  for (int i = 0; i < n; ++i) disc_x_.push_back(-footprint.rear + (i + 0.5) * slice);
   disc_offset_y_ = 0.5 * (footprint.left - footprint.right);
+  constexpr double kSafety = 1e-4;  // [m] covers the float rounding of the stored distances
+  bound_margin_ = disc_radius_ + kInvSqrt2 * costmap.resolution() + kSafety;
+  // Pieces of about kPieceCells cells a side: small enough that most of a piece's bounding box
+  // (at most twice its area) lies near the piece, large enough to keep the box lookups few.
+  const double piece = kPieceCells * costmap.resolution();
+  const auto pieces = [&](double side) { return std::clamp(static_cast<int>(std::ceil(side / piece)), 1, kMaxPieces); };
+  pieces_x_ = pieces(footprint.length());
+  pieces_y_ = pieces(footprint.width());
 }
 
 double GridCollisionChecker::sweep_factor(double curvature) const {
@@ -32,34 +115,47 @@ double GridCollisionChecker::sweep_factor(double curvature) const {
   const double k = std::abs(curvature);
   const double far_x = std::max(footprint_.front, footprint_.rear);
   const double far_y = std::max(footprint_.left, footprint_.right);
-  return std::hypot(1.0 + k * far_y, k * far_x);
+  const double a = 1.0 + k * far_y;
+  const double b = k * far_x;
+  return std::sqrt(a * a + b * b);
+}
+
+inline GridCollisionChecker::GridPose GridCollisionChecker::grid_pose(const Pose2& pose, double c, double s) const {
+  // Costmap::to_grid with the heading rotated along (X_GV = X_MG^-1 X_MV), cell units.
+  const double dx = pose.x - origin_x_;
+  const double dy = pose.y - origin_y_;
+  return {(origin_cos_ * dx + origin_sin_ * dy) * inv_resolution_,
+          (origin_cos_ * dy - origin_sin_ * dx) * inv_resolution_,
+          (origin_cos_ * c + origin_sin_ * s) * inv_resolution_, (origin_cos_ * s - origin_sin_ * c) * inv_resolution_};
 }
 
 double GridCollisionChecker::clearance_lower_bound(const Pose2& pose) const {
-  return clearance_bound(pose, std::cos(pose.yaw), std::sin(pose.yaw));
+  return clearance_bound(grid_pose(pose, std::cos(pose.yaw), std::sin(pose.yaw)));
 }
 
-double GridCollisionChecker::clearance_bound(const Pose2& pose, double c, double s) const {
+double GridCollisionChecker::clearance_bound(const GridPose& g) const {
   // For a disc centre p in cell k (centre q_k): every occupied square is at least
-  // D(k) - |p - q_k| - res / sqrt2 away (D: centre distance to the nearest occupied centre).
-  constexpr double kSafety = 1e-4;  // [m] covers the float rounding of the stored distances
+  // D(k) - |p - q_k| - res / sqrt2 away (D: centre distance to the nearest occupied centre; 0 on
+  // an occupied cell), so the disc is at least that minus its radius away.
   const double res = costmap_.resolution();
+  // Disc centres in the grid frame: the first one, then a constant step along the axis.
+  double px = g.x + disc_first_x_ * g.ux - disc_offset_y_ * g.uy;
+  double py = g.y + disc_first_x_ * g.uy + disc_offset_y_ * g.ux;
+  const double step_x = disc_step_ * g.ux;
+  const double step_y = disc_step_ * g.uy;
   double best = std::numeric_limits<double>::infinity();
-  for (const double x : disc_x_) {
-    const Vec2 g = costmap_.to_grid({pose.x + c * x - s * disc_offset_y_, pose.y + s * x + c * disc_offset_y_});
-    const double fx = std::floor(g.x());
-    const double fy = std::floor(g.y());
-    if (fx < 0.0 || fy < 0.0 || fx >= costmap_.width() || fy >= costmap_.height()) return 0.0;
-    const int ix = static_cast<int>(fx);
-    const int iy = static_cast<int>(fy);
-    if (costmap_.occupied(ix, iy)) return 0.0;
-    const double ox = g.x() - fx - 0.5;
-    const double oy = g.y() - fy - 0.5;
+  for (int k = 0; k < disc_count_; ++k, px += step_x, py += step_y) {
+    // A centre outside the grid: the footprint leaves it (also catches NaN).
+    if (!(px >= 0.0 && py >= 0.0 && px < grid_width_ && py < grid_height_)) return 0.0;
+    const int ix = static_cast<int>(px);
+    const int iy = static_cast<int>(py);
+    const double ox = std::abs(px - ix - 0.5);
+    const double oy = std::abs(py - iy - 0.5);
     const double off = std::sqrt(ox * ox + oy * oy) * res;
-    best = std::min(best, costmap_.centre_distance(ix, iy) - off - kInvSqrt2 * res - disc_radius_ - kSafety);
-    if (best <= 0.0) return 0.0;
+    best = std::min(best, costmap_.centre_distance(ix, iy) - off);
+    if (best <= bound_margin_) return 0.0;
   }
-  return best;
+  return best - bound_margin_;
 }
 
 bool GridCollisionChecker::collides(const Pose2& pose) const {
@@ -72,83 +168,71 @@ bool GridCollisionChecker::collides(const Pose2& pose, double& bound) const {
 }
 
 bool GridCollisionChecker::collides(const Pose2& pose, double c, double s, double& bound) const {
-  bound = clearance_bound(pose, c, s);
+  const GridPose g = grid_pose(pose, c, s);
+  bound = clearance_bound(g);
   if (bound > 0.0) return false;
-  return collides_exact(pose, c, s);
+  return collides_exact(g);
 }
 
-bool GridCollisionChecker::collides_exact(const Pose2& pose, double c, double s) const {
-  // Corners in the grid frame (cell units), counter-clockwise.
+bool GridCollisionChecker::collides_exact(const GridPose& g) const {
   const Footprint& f = footprint_;
-  const std::array<Vec2, 4> local{Vec2{f.front, f.left}, Vec2{-f.rear, f.left}, Vec2{-f.rear, -f.right},
-                                  Vec2{f.front, -f.right}};
-  std::array<Vec2, 4> g;
-  double y_lo = std::numeric_limits<double>::infinity();
-  double y_hi = -y_lo;
-  double x_lo = y_lo;
-  double x_hi = -y_lo;
-  for (std::size_t i = 0; i < 4; ++i) {
-    g[i] =
-        costmap_.to_grid({pose.x + c * local[i].x() - s * local[i].y(), pose.y + s * local[i].x() + c * local[i].y()});
-    y_lo = std::min(y_lo, g[i].y());
-    y_hi = std::max(y_hi, g[i].y());
-    x_lo = std::min(x_lo, g[i].x());
-    x_hi = std::max(x_hi, g[i].x());
+  // The rectangle cut into pieces_x_ x pieces_y_ equal pieces: lattice offsets from the rear axle
+  // along the axis (a_i * u) and across it (b_k * v, v = u turned left), grid frame. The outer
+  // lattice lines are the rectangle's sides exactly; neighbouring pieces share their lattice
+  // points, so the closed pieces cover the closed rectangle without gaps.
+  const int nx = pieces_x_;
+  const int ny = pieces_y_;
+  std::array<double, kMaxPieces + 1> ax;
+  std::array<double, kMaxPieces + 1> ay;
+  std::array<double, kMaxPieces + 1> bx;
+  std::array<double, kMaxPieces + 1> by;
+  for (int i = 0; i <= nx; ++i) {
+    const double a = i == nx ? f.front : -f.rear + i * (f.length() / nx);
+    ax[static_cast<std::size_t>(i)] = a * g.ux;
+    ay[static_cast<std::size_t>(i)] = a * g.uy;
   }
-  // Outside the grid is occupied (a touch of the far edge counts: cell `width` is outside).
-  if (x_lo < 0.0 || y_lo < 0.0 || x_hi >= costmap_.width() || y_hi >= costmap_.height()) return true;
-  const int j0 = static_cast<int>(std::floor(y_lo));
-  const int j1 = static_cast<int>(std::floor(y_hi));
-  const int rows = j1 - j0 + 1;
-  if (rows > kMaxRows) {
-    for (int j = j0; j <= j1; ++j) {
-      double a = 0.0;
-      double b = 0.0;
-      if (!strip_extent(g.data(), 4, j, j + 1.0, a, b)) continue;
-      if (costmap_.occupied_in_row(j, static_cast<int>(std::floor(a)), static_cast<int>(std::floor(b))) > 0) {
-        return true;
-      }
-    }
-    return false;
+  for (int k = 0; k <= ny; ++k) {
+    const double b = k == ny ? f.left : -f.right + k * (f.width() / ny);
+    bx[static_cast<std::size_t>(k)] = -b * g.uy;
+    by[static_cast<std::size_t>(k)] = b * g.ux;
   }
-  // Each edge adds its exact x range within every row strip it crosses; a rectangle's extent in
-  // a strip is the union of its edges' ranges there (a strip that cuts the rectangle cuts its
-  // boundary on both sides).
-  std::array<double, kMaxRows> lo;
-  std::array<double, kMaxRows> hi;
-  std::fill_n(lo.begin(), rows, std::numeric_limits<double>::infinity());
-  std::fill_n(hi.begin(), rows, -std::numeric_limits<double>::infinity());
-  const auto add = [&](int j, double xa, double xb) {
-    if (j < j0 || j > j1) return;
-    const auto r = static_cast<std::size_t>(j - j0);
-    lo[r] = std::min(lo[r], std::min(xa, xb));
-    hi[r] = std::max(hi[r], std::max(xa, xb));
+  const auto point = [&](int i, int k) {
+    return Vec2{g.x + ax[static_cast<std::size_t>(i)] + bx[static_cast<std::size_t>(k)],
+                g.y + ay[static_cast<std::size_t>(i)] + by[static_cast<std::size_t>(k)]};
   };
-  for (std::size_t i = 0; i < 4; ++i) {
-    const Vec2& a = g[i];
-    const Vec2& b = g[(i + 1) % 4];
-    const double ya = std::min(a.y(), b.y());
-    const double yb = std::max(a.y(), b.y());
-    const int ja = static_cast<int>(std::floor(ya));
-    const int jb = static_cast<int>(std::floor(yb));
-    if (yb == ya) {
-      add(ja, a.x(), b.x());
-      if (ya == ja) add(ja - 1, a.x(), b.x());  // on a row boundary: it touches both rows
-      continue;
+  const auto bounds = [](const std::array<Vec2, 4>& q, double& x_lo, double& y_lo, double& x_hi, double& y_hi) {
+    x_lo = std::min(std::min(q[0].x(), q[1].x()), std::min(q[2].x(), q[3].x()));
+    x_hi = std::max(std::max(q[0].x(), q[1].x()), std::max(q[2].x(), q[3].x()));
+    y_lo = std::min(std::min(q[0].y(), q[1].y()), std::min(q[2].y(), q[3].y()));
+    y_hi = std::max(std::max(q[0].y(), q[1].y()), std::max(q[2].y(), q[3].y()));
+  };
+  const std::array<Vec2, 4> corners{point(0, 0), point(nx, 0), point(nx, ny), point(0, ny)};
+  double x_lo = 0.0;
+  double y_lo = 0.0;
+  double x_hi = 0.0;
+  double y_hi = 0.0;
+  bounds(corners, x_lo, y_lo, x_hi, y_hi);
+  // Outside the grid is occupied (a touch of the far edge counts: cell `width` is outside). NaN
+  // fails the test too.
+  if (!(x_lo >= 0.0 && y_lo >= 0.0 && x_hi < grid_width_ && y_hi < grid_height_)) return true;
+  // Any cell the rectangle touches, touches its bounding box: an empty box is no collision.
+  const auto box_empty = [&](double bx_lo, double by_lo, double bx_hi, double by_hi, int& j0, int& j1) {
+    j0 = std::max(0, cell_first(by_lo));
+    j1 = cell_last(by_hi);
+    return costmap_.occupied_in_box_inside(std::max(0, cell_first(bx_lo)), j0, cell_last(bx_hi), j1) == 0;
+  };
+  int j0 = 0;
+  int j1 = 0;
+  if (box_empty(x_lo, y_lo, x_hi, y_hi, j0, j1)) return false;
+  if (nx * ny == 1) return polygon_hits(costmap_, corners.data(), 4, j0, j1);
+  // Otherwise only the pieces whose own box holds an occupied cell need the exact row walk.
+  for (int i = 0; i < nx; ++i) {
+    for (int k = 0; k < ny; ++k) {
+      const std::array<Vec2, 4> q{point(i, k), point(i + 1, k), point(i + 1, k + 1), point(i, k + 1)};
+      bounds(q, x_lo, y_lo, x_hi, y_hi);
+      if (box_empty(x_lo, y_lo, x_hi, y_hi, j0, j1)) continue;
+      if (polygon_hits(costmap_, q.data(), 4, j0, j1)) return true;
     }
-    const double slope = (b.x() - a.x()) / (b.y() - a.y());
-    for (int j = ja; j <= jb; ++j) {
-      const double y0 = std::max(ya, static_cast<double>(j));
-      const double y1 = std::min(yb, j + 1.0);
-      add(j, a.x() + (y0 - a.y()) * slope, a.x() + (y1 - a.y()) * slope);
-    }
-    if (ya == ja) add(ja - 1, a.x() + (ya - a.y()) * slope, a.x() + (ya - a.y()) * slope);
-  }
-  for (int r = 0; r < rows; ++r) {
-    if (lo[static_cast<std::size_t>(r)] > hi[static_cast<std::size_t>(r)]) continue;
-    const int c0 = static_cast<int>(std::floor(lo[static_cast<std::size_t>(r)]));
-    const int c1 = static_cast<int>(std::floor(hi[static_cast<std::size_t>(r)]));
-    if (costmap_.occupied_in_row(j0 + r, c0, c1) > 0) return true;
   }
   return false;
 }

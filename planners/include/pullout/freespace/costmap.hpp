@@ -1,6 +1,6 @@
 // The costmap of the freespace planner: a binary occupancy grid with what the search needs
-// precomputed (row prefix sums for exact footprint tests, a Euclidean distance transform for cheap
-// clearance bounds).
+// precomputed (a summed-area table for exact footprint tests, a Euclidean distance transform for
+// cheap clearance bounds).
 //
 // Frames: the grid frame G has its origin at the outer corner of cell (0, 0) and its axes along
 // the rows (+x, increasing column) and columns (+y, increasing row); X_MG = `origin` is its pose in
@@ -74,8 +74,20 @@ class Costmap {
   double clearance_lower_bound(const Vec2& p_M) const;
 
   // Number of occupied cells in row iy between columns c0 and c1 (inclusive, clamped to the grid;
-  // columns outside the grid count as occupied).
+  // columns outside the grid count as occupied; 0 when c1 < c0).
   int occupied_in_row(int iy, int c0, int c1) const;
+  // Number of occupied cells in the box of columns c0..c1 and rows r0..r1 (inclusive, clamped to
+  // the grid; cells outside the grid count as occupied; 0 for an empty range). O(1): four
+  // summed-area table lookups.
+  long long occupied_in_box(int c0, int r0, int c1, int r1) const;
+  // The same for a non-empty box inside the grid (0 <= c0 <= c1 < width, 0 <= r0 <= r1 < height),
+  // without the clamping: the collision checker's hot path.
+  int occupied_in_box_inside(int c0, int r0, int c1, int r1) const {
+    const std::size_t stride = static_cast<std::size_t>(width_) + 1;
+    const std::int32_t* lo = box_prefix_.data() + static_cast<std::size_t>(r0) * stride;
+    const std::int32_t* hi = box_prefix_.data() + static_cast<std::size_t>(r1 + 1) * stride;
+    return hi[c1 + 1] - hi[c0] - lo[c1 + 1] + lo[c0];
+  }
 
  private:
   std::size_t index(int ix, int iy) const {
@@ -90,8 +102,10 @@ class Costmap {
   int width_{0};
   int height_{0};
   std::vector<std::uint8_t> occupied_;
-  std::vector<std::int32_t> row_prefix_;  // (width + 1) per row: occupied cells left of column c
-  std::vector<float> distance_;           // [m] see centre_distance
+  std::vector<float> distance_;  // [m] see centre_distance
+  // Summed-area table, (width + 1) x (height + 1): occupied cells in columns < c and rows < r (a
+  // row's count is the difference of two neighbouring table rows).
+  std::vector<std::int32_t> box_prefix_;
 };
 
 // The column extent of a convex polygon (grid frame, cell units) within the horizontal strip

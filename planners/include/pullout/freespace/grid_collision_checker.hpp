@@ -2,15 +2,16 @@
 //
 // "Collision" means the closed footprint rectangle and some closed occupied cell square share a
 // point (touching counts), or the footprint leaves the grid. The test is exact up to floating
-// point: the rectangle is cut into the grid's row strips, each strip's exact column extent is
-// looked up in the costmap's row prefix sums (one lookup per row). A bound from the distance
-// transform (the rectangle covered by a few discs) answers most queries without that walk.
+// point. It narrows down where to look with the costmap's summed-area table: no occupied cell in
+// the rectangle's axis-aligned bounding box means no collision; otherwise the rectangle is cut
+// into a few pieces, and only the pieces whose bounding box holds an occupied cell are cut into
+// the grid's row strips, each strip's exact column extent counted in the same table. A
+// bound from the distance transform (the rectangle covered by a few discs) answers most queries
+// of collides(pose, bound) without the exact test.
 //
 // Thread safety: const methods may be called concurrently. The checker keeps a reference to the
 // costmap, which must outlive it.
 #pragma once
-
-#include <vector>
 
 #include "pullout/collision/footprint.hpp"
 #include "pullout/freespace/costmap.hpp"
@@ -40,15 +41,37 @@ class GridCollisionChecker {
   double sweep_factor(double curvature) const;
 
  private:
-  double clearance_bound(const Pose2& pose, double c, double s) const;
-  bool collides_exact(const Pose2& pose, double c, double s) const;
+  // The pose in the grid frame: the rear axle (cells) and the vehicle's +x axis (cells per metre).
+  struct GridPose {
+    double x, y, ux, uy;
+  };
+  GridPose grid_pose(const Pose2& pose, double c, double s) const;
+  double clearance_bound(const GridPose& g) const;
+  bool collides_exact(const GridPose& g) const;
 
   const Costmap& costmap_;
   Footprint footprint_;
-  // Discs covering the rectangle: centres on the vehicle axis (base_link frame) and one radius.
-  std::vector<double> disc_x_;
+  // The costmap's frame and size, kept here for the hot paths.
+  double origin_x_{0.0};
+  double origin_y_{0.0};
+  double origin_cos_{1.0};
+  double origin_sin_{0.0};
+  double inv_resolution_{1.0};
+  double grid_width_{0.0};
+  double grid_height_{0.0};
+  // Discs covering the rectangle: centres on the vehicle axis (base_link frame), first_x +
+  // k * step for k < count, offset sideways by offset_y; one radius. bound_margin is what a disc
+  // centre's cell distance loses (radius, the cell half-diagonal, float safety).
+  int disc_count_{1};
+  double disc_first_x_{0.0};
+  double disc_step_{0.0};
   double disc_offset_y_{0.0};
   double disc_radius_{0.0};
+  double bound_margin_{0.0};
+  // The exact test splits the rectangle into pieces_x_ x pieces_y_ equal pieces (see
+  // collides_exact).
+  int pieces_x_{1};
+  int pieces_y_{1};
 };
 
 }  // namespace pullout
