@@ -48,10 +48,15 @@ bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_cleara
   const double uncovered_end = total - end_clearance / factor;  // so is [uncovered_end, total]
   const double half_stretch = checkers.growth / factor;
   while (covered < uncovered_end) {
-    const double s = std::min(covered + half_stretch, total);
+    // The last test sits half a stretch before the end (not on it: the grown footprint there would
+    // reach past the end pose, towards what it may be close to), the first half a stretch after
+    // the start.
+    const bool last = covered + 2.0 * half_stretch >= total;  // this test's stretch reaches the end
+    const double s = last ? std::max(0.0, total - half_stretch) : covered + half_stretch;
     const Pose2 pose = arc.at(sign * s, c, sn);
     double clearance = 0.0;
     if (checkers.swept.collides(pose, c, sn, clearance)) return false;
+    if (last) break;  // (not left to the loop condition: rounding could repeat the same test)
     covered = s + half_stretch + clearance / factor;
   }
   return true;
