@@ -20,6 +20,7 @@ constexpr double kShotDistancePerInterval = 4.0;    // [m] heuristic distance pe
 constexpr double kReedsSheppRange = 4.0;            // [turning radii] see heuristic()
 constexpr double kCoarseSpacing = 1.0;              // [m] first-pass sample spacing of a shot
 constexpr double kSweepGrowth = 0.5;                // [cells] footprint growth between tested poses
+constexpr double kFineSweepGrowth = 0.125;          // [cells] the same where kSweepGrowth refuses
 
 double wrap(double a) {
   a = std::fmod(a + kTwoPi / 2.0, kTwoPi);
@@ -56,7 +57,9 @@ class Search {
         weights_{config.curve_weight, config.reverse_weight, config.direction_change_weight},
         heuristic_(costmap_, heuristic_config(checker, config), goal),
         swept_checker_(costmap_, grown(checker.footprint(), kSweepGrowth * costmap_.resolution())),
-        sweep_{checker_, swept_checker_, kSweepGrowth * costmap_.resolution()} {}
+        fine_checker_(costmap_, grown(checker.footprint(), kFineSweepGrowth * costmap_.resolution())),
+        sweep_{checker_, swept_checker_, kSweepGrowth * costmap_.resolution(), fine_checker_,
+               kFineSweepGrowth * costmap_.resolution()} {}
 
   HybridAStarResult run(const Deadline& deadline) {
     HybridAStarResult result;
@@ -308,6 +311,7 @@ class Search {
   ReedsSheppWeights weights_;
   fd::ObstacleHeuristic heuristic_;
   GridCollisionChecker swept_checker_;  // the footprint grown for the motion between tested poses
+  GridCollisionChecker fine_checker_;   // grown less, where swept_checker_ refuses
   fd::SweepCheckers sweep_;
   std::vector<Node> nodes_;
   fd::NodeTable table_;

@@ -34,6 +34,30 @@ Pose2 Arc::at(double distance, double& cos_yaw, double& sin_yaw) const {
   return {from_.x + r * (sin_yaw - sin_), from_.y + r * (cos_ - cos_yaw), yaw};
 }
 
+namespace {
+
+// Covers [from, to] of the arc with tests of `checker` (the footprint grown by `growth`): true when
+// all pass. The tests sit at most half a stretch inside the interval's ends (a test's grown
+// footprint reaches half a stretch of motion both ways, and no farther).
+bool cover(const GridCollisionChecker& checker, double growth, const Arc& arc, double sign, double factor, double from,
+           double to) {
+  const double half_stretch = growth / factor;
+  double covered = from;
+  double c = 1.0;
+  double sn = 0.0;
+  while (covered < to) {
+    const bool last = covered + 2.0 * half_stretch >= to;  // this test's stretch reaches `to`
+    const double s = last ? std::max(from, to - half_stretch) : covered + half_stretch;
+    double clearance = 0.0;
+    if (checker.collides(arc.at(sign * s, c, sn), c, sn, clearance)) return false;
+    if (last) break;  // (not left to the loop condition: rounding could repeat the same test)
+    covered = s + half_stretch + clearance / factor;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_clearance, double distance,
               double& end_clearance) {
   const double total = std::abs(distance);
@@ -49,15 +73,18 @@ bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_cleara
   const double half_stretch = checkers.growth / factor;
   while (covered < uncovered_end) {
     // The last test sits half a stretch before the end (not on it: the grown footprint there would
-    // reach past the end pose, towards what it may be close to), the first half a stretch after
-    // the start.
-    const bool last = covered + 2.0 * half_stretch >= total;  // this test's stretch reaches the end
+    // reach past the end pose, towards what it may be close to).
+    const bool last = covered + 2.0 * half_stretch >= total;
     const double s = last ? std::max(0.0, total - half_stretch) : covered + half_stretch;
-    const Pose2 pose = arc.at(sign * s, c, sn);
+    const double stretch_end = std::min(total, s + half_stretch);
     double clearance = 0.0;
-    if (checkers.swept.collides(pose, c, sn, clearance)) return false;
+    if (checkers.swept.collides(arc.at(sign * s, c, sn), c, sn, clearance)) {
+      // Refused by the coarse growth: the same stretch in finer tests decides.
+      if (!cover(checkers.fine, checkers.fine_growth, arc, sign, factor, covered, stretch_end)) return false;
+      clearance = 0.0;
+    }
     if (last) break;  // (not left to the loop condition: rounding could repeat the same test)
-    covered = s + half_stretch + clearance / factor;
+    covered = stretch_end + clearance / factor;
   }
   return true;
 }

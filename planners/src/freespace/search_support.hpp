@@ -33,12 +33,16 @@ class Arc {
   double curvature_{0.0};
 };
 
-// The two collision tests of a swept footprint: `exact` for the poses where the search stops, and
-// `swept`, the same footprint grown by `growth` [m] on every side, for the motion in between.
+// The collision tests of a swept footprint: `exact` for the poses where the search stops, and
+// `swept`, the same footprint grown by `growth` [m] on every side, for the motion in between;
+// where that refuses a stretch, `fine` (grown by `fine_growth` < growth) re-tests it in shorter
+// stretches, so that the refusal is only as conservative as fine_growth.
 struct SweepCheckers {
   const GridCollisionChecker& exact;
   const GridCollisionChecker& swept;
   double growth{0.0};
+  const GridCollisionChecker& fine;
+  double fine_growth{0.0};
 };
 
 // True when the footprint stays clear of every occupied cell over the whole arc, the motion
@@ -50,7 +54,7 @@ struct SweepCheckers {
 // sweep_factor * l, so over [s - u, s + u] (u = growth / sweep_factor) the body stays inside the
 // footprint at s grown by `growth`: one test of the grown footprint covers that stretch, and its
 // clearance bound c widens it by c / sweep_factor each way. The test is conservative (a sweep that
-// passes within `growth` of an occupied cell is refused), never optimistic.
+// passes within `fine_growth` of an occupied cell is refused), never optimistic.
 bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_clearance, double distance,
               double& end_clearance);
 

@@ -29,9 +29,10 @@
 // Collision: the poses the search stops at (nodes, the goal) are tested exactly against the
 // costmap (GridCollisionChecker). The motion between them is covered completely, conservatively:
 // the footprint grown by half a cell, tested at poses spaced so that the body cannot leave the
-// grown rectangle in between (see arc_free in search_support.hpp); the clearance bound of a test
-// skips the stretch it proves free. So a returned path is collision-free at every point, not
-// only at its samples.
+// grown rectangle in between (see arc_free in search_support.hpp), and where that refuses, grown
+// by an eighth of a cell in four times as many tests; the clearance bound of a test skips the
+// stretch it proves free. So a returned path is collision-free at every point, not only at its
+// samples, and a motion is refused only if it passes within an eighth of a cell of an obstacle.
 //
 // Failure modes are values (Status), never exceptions. The deadline is checked between
 // expansions; the search returns kTimeout promptly after it expires.
