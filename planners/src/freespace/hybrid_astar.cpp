@@ -309,7 +309,7 @@ class Search {
   Pose2 goal_;
   ReedsShepp rs_;
   ReedsSheppWeights weights_;
-  fd::ObstacleHeuristic heuristic_;
+  mutable fd::ObstacleHeuristic heuristic_;  // computed lazily, as the search asks
   GridCollisionChecker swept_checker_;  // the footprint grown for the motion between tested poses
   GridCollisionChecker fine_checker_;   // grown less, where swept_checker_ refuses
   fd::SweepCheckers sweep_;

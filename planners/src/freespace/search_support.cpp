@@ -99,53 +99,60 @@ bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, do
 }
 
 ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal)
-    : costmap_(costmap) {
-  const double half_width = config.half_width;
+    : costmap_(costmap), config_(config) {
   factor_ = std::max(1, static_cast<int>(std::round(config.cell_size / costmap.resolution())));
   cell_size_ = factor_ * costmap.resolution();
   width_ = (costmap.width() + factor_ - 1) / factor_;
   height_ = (costmap.height() + factor_ - 1) / factor_;
   const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
-  // A costmap cell is surely infeasible for the rear axle when even the most favourable point in
-  // it is closer than half_width to an obstacle (centre distance + half a diagonal each way).
-  const double slack = std::sqrt(2.0) * costmap.resolution();
-  std::vector<std::uint8_t> blocked(n, 1);
-  std::vector<float> room(n, 0.0F);
-  for (int j = 0; j < costmap.height(); ++j) {
-    for (int i = 0; i < costmap.width(); ++i) {
-      if (costmap.occupied(i, j)) continue;
-      const std::size_t c = static_cast<std::size_t>(j / factor_) * width_ + (i / factor_);
-      const double d = costmap.centre_distance(i, j);
-      room[c] = std::max(room[c], static_cast<float>(d));
-      if (d + slack >= half_width) blocked[c] = 0;
-    }
-  }
-  // Per-metre cost of crossing each cell; an edge costs the mean of its two cells'.
-  std::vector<float>& rate = room;  // reused in place
-  for (float& r : rate) {
-    const double narrowness = std::max(0.0, 1.0 - r / config.turning_room);
-    r = static_cast<float>(1.0 + config.narrow_penalty * narrowness);
-  }
   distance_.assign(n, std::numeric_limits<float>::infinity());
+  rate_.assign(n, std::numeric_limits<float>::quiet_NaN());
   int gi = 0;
   int gj = 0;
   costmap.cell_of({goal.x, goal.y}, gi, gj);
   if (!costmap.inside(gi, gj)) return;
-  gi /= factor_;
-  gj /= factor_;
-  using Item = std::pair<float, std::int32_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
-  const std::int32_t start = gj * width_ + gi;
+  const std::int32_t start = (gj / factor_) * width_ + (gi / factor_);
   distance_[static_cast<std::size_t>(start)] = 0.0F;
-  open.push({0.0F, start});
+  open_.push({0.0F, start});
+}
+
+float ObstacleHeuristic::rate(std::int32_t c) {
+  float& r = rate_[static_cast<std::size_t>(c)];
+  if (!std::isnan(r)) return r;
+  // A costmap cell is surely infeasible for the rear axle when even the most favourable point in
+  // it is closer than half_width to an obstacle (centre distance + half a diagonal each way); the
+  // coarse cell is blocked when all of its cells are. Its room: the largest obstacle distance.
+  const double slack = std::sqrt(2.0) * costmap_.resolution();
+  const int i0 = (c % width_) * factor_;
+  const int j0 = (c / width_) * factor_;
+  const int i1 = std::min(costmap_.width(), i0 + factor_);
+  const int j1 = std::min(costmap_.height(), j0 + factor_);
+  bool blocked = true;
+  double room = 0.0;
+  for (int j = j0; j < j1; ++j) {
+    for (int i = i0; i < i1; ++i) {
+      if (costmap_.occupied(i, j)) continue;
+      const double d = costmap_.centre_distance(i, j);
+      room = std::max(room, d);
+      if (d + slack >= config_.half_width) blocked = false;
+    }
+  }
+  const double narrowness = std::max(0.0, 1.0 - room / config_.turning_room);
+  r = blocked ? std::numeric_limits<float>::infinity() : static_cast<float>(1.0 + config_.narrow_penalty * narrowness);
+  return r;
+}
+
+float ObstacleHeuristic::settle(std::int32_t c) {
+  // A cell's distance is final once nothing left on the open list is closer to the goal.
   const float straight = static_cast<float>(cell_size_);
   const float diagonal = static_cast<float>(cell_size_ * std::sqrt(2.0));
   constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
-  while (!open.empty()) {
-    const auto [d, idx] = open.top();
-    open.pop();
+  while (!open_.empty() && open_.top().first < distance_[static_cast<std::size_t>(c)]) {
+    const auto [d, idx] = open_.top();
+    open_.pop();
     if (d > distance_[static_cast<std::size_t>(idx)]) continue;
+    const float own = rate(idx);
     const int x = idx % width_;
     const int y = idx / width_;
     for (int k = 0; k < 8; ++k) {
@@ -153,26 +160,35 @@ ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuri
       const int ny = y + kDy[k];
       if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
       const std::int32_t nidx = ny * width_ + nx;
-      if (blocked[static_cast<std::size_t>(nidx)] != 0) continue;
-      const float step = (k < 4 ? straight : diagonal) * 0.5F *
-                         (rate[static_cast<std::size_t>(idx)] + rate[static_cast<std::size_t>(nidx)]);
-      const float nd = d + step;
+      const float next = rate(nidx);
+      if (std::isinf(next)) continue;
+      // An edge costs its length at the mean of its two cells' rates (the goal's own cell may be
+      // "blocked" for the disc test: it then counts at the neighbour's rate).
+      const float mean = std::isinf(own) ? next : 0.5F * (own + next);
+      const float nd = d + (k < 4 ? straight : diagonal) * mean;
       if (nd < distance_[static_cast<std::size_t>(nidx)]) {
         distance_[static_cast<std::size_t>(nidx)] = nd;
-        open.push({nd, nidx});
+        open_.push({nd, nidx});
       }
     }
   }
+  return distance_[static_cast<std::size_t>(c)];
 }
 
-double ObstacleHeuristic::distance(const Pose2& p) const {
+double ObstacleHeuristic::distance(const Pose2& p) {
   int i = 0;
   int j = 0;
   costmap_.cell_of({p.x, p.y}, i, j);
   if (!costmap_.inside(i, j)) return std::numeric_limits<double>::infinity();
-  const int ci = i / factor_;
-  const int cj = j / factor_;
-  const double own = distance_[static_cast<std::size_t>(cj) * width_ + ci];
+  // Blocked cells are never reached (except the goal's own): no need to run the search for them.
+  const auto at = [this](int x, int y) {
+    const std::int32_t c = y * width_ + x;
+    if (std::isinf(rate(c)) && distance_[static_cast<std::size_t>(c)] != 0.0F) {
+      return std::numeric_limits<double>::infinity();
+    }
+    return static_cast<double>(settle(c));
+  };
+  const double own = at(i / factor_, j / factor_);
   if (!std::isfinite(own)) return own;
   // Bilinear between the four nearest cell centres, so that the value changes smoothly with the
   // pose: a step of a whole cell's worth at cell borders would drown the cost differences of
@@ -183,9 +199,6 @@ double ObstacleHeuristic::distance(const Pose2& p) const {
   if (width_ < 2 || height_ < 2) return own;
   const double tx = std::clamp(g.x() - x0, 0.0, 1.0);
   const double ty = std::clamp(g.y() - y0, 0.0, 1.0);
-  const auto at = [this](int x, int y) {
-    return static_cast<double>(distance_[static_cast<std::size_t>(y) * width_ + x]);
-  };
   const double d00 = at(x0, y0);
   const double d10 = at(x0 + 1, y0);
   const double d01 = at(x0, y0 + 1);

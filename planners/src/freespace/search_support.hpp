@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <limits>
+#include <queue>
+#include <utility>
 #include <vector>
 
 #include "pullout/freespace/costmap.hpp"
@@ -81,20 +83,33 @@ struct ObstacleHeuristicConfig {
   double narrow_penalty{0.0};
 };
 
+// Computed lazily: the Dijkstra search from the goal runs only until the cells asked for are
+// final, and a cell's passability and rate are worked out when the search first reaches it, so
+// the cost follows the part of the map the hybrid A* explores, not the map's size. Not thread
+// safe (distance() advances the search); one per plan.
 class ObstacleHeuristic {
  public:
   ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal);
 
   // Distance [m] from p (map frame) to the goal; +inf when the goal cannot be reached from p.
-  double distance(const Pose2& p) const;
+  double distance(const Pose2& p);
 
  private:
+  // The final distance of coarse cell `c`, running the search as far as that needs.
+  float settle(std::int32_t c);
+  // Per-metre cost of crossing coarse cell `c` (+inf: blocked), from its costmap cells on first use.
+  float rate(std::int32_t c);
+
   const Costmap& costmap_;
+  ObstacleHeuristicConfig config_;
   int factor_{1};  // costmap cells per coarse cell, per axis
   int width_{0};
   int height_{0};
   double cell_size_{0.0};
   std::vector<float> distance_;
+  std::vector<float> rate_;  // NaN until computed
+  using Item = std::pair<float, std::int32_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open_;
 };
 
 // Open-addressing map from a lattice key to a node index.
