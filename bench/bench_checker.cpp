@@ -29,14 +29,13 @@ using pullout::Pose2;
 
 constexpr double kPi = 3.14159265358979323846;
 
+// A length x width box centred on (cx, cy), turned by yaw: a parked car or a wall.
 pullout::Polygon box(double cx, double cy, double yaw, double length, double width) {
-  const double c = std::cos(yaw), s = std::sin(yaw);
-  pullout::Polygon p;
-  for (const auto& [lx, ly] : {std::pair{0.5, 0.5}, {-0.5, 0.5}, {-0.5, -0.5}, {0.5, -0.5}}) {
-    const double x = lx * length, y = ly * width;
-    p.push_back({cx + c * x - s * y, cy + s * x + c * y});
-  }
-  return p;
+  pullout::Object o;
+  o.pose = {cx, cy, yaw};
+  o.length_m = length;
+  o.width_m = width;
+  return pullout::object_polygon(o);
 }
 
 // A square lot `size` m across: 0.4 m walls, rows of 2.7 m x 5.5 m bays (double rows between 7 m

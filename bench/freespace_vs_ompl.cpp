@@ -40,6 +40,7 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
+#include "pullout/collision/footprint.hpp"
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/freespace/hybrid_astar.hpp"
@@ -68,14 +69,13 @@ struct Problem {
   Pose2 goal;
 };
 
+// A length x width box centred on (cx, cy), turned by yaw: a parked car or a wall.
 pullout::Polygon box(double cx, double cy, double yaw, double length, double width) {
-  const double c = std::cos(yaw), s = std::sin(yaw);
-  pullout::Polygon p;
-  for (const auto& [lx, ly] : {std::pair{0.5, 0.5}, {-0.5, 0.5}, {-0.5, -0.5}, {0.5, -0.5}}) {
-    const double x = lx * length, y = ly * width;
-    p.push_back({cx + c * x - s * y, cy + s * x + c * y});
-  }
-  return p;
+  pullout::Object o;
+  o.pose = {cx, cy, yaw};
+  o.length_m = length;
+  o.width_m = width;
+  return pullout::object_polygon(o);
 }
 
 // A bay: its centre and the direction its opening faces (+1: the aisle is above, -1: below).

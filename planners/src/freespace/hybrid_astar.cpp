@@ -310,8 +310,8 @@ class Search {
   ReedsShepp rs_;
   ReedsSheppWeights weights_;
   mutable fd::ObstacleHeuristic heuristic_;  // computed lazily, as the search asks
-  GridCollisionChecker swept_checker_;  // the footprint grown for the motion between tested poses
-  GridCollisionChecker fine_checker_;   // grown less, where swept_checker_ refuses
+  GridCollisionChecker swept_checker_;       // the footprint grown for the motion between tested poses
+  GridCollisionChecker fine_checker_;        // grown less, where swept_checker_ refuses
   fd::SweepCheckers sweep_;
   std::vector<Node> nodes_;
   fd::NodeTable table_;
