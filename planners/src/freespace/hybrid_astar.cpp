@@ -200,9 +200,7 @@ class Search {
       for (int steer = -steps; steer <= steps; ++steer) {
         const fd::Arc arc(parent.pose, c, s, static_cast<double>(steer) / steps / config_.turning_radius);
         const double distance = direction * length;
-        double unused_c = 0.0;
-        double unused_s = 0.0;
-        const Pose2 child_pose = arc.at(distance, unused_c, unused_s);
+        const Pose2 child_pose = arc.at(distance);
         if (key(child_pose) == parent_key) continue;
         double clearance = 0.0;
         if (!fd::arc_free(sweep_, arc, parent.clearance, distance, clearance)) continue;

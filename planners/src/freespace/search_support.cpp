@@ -6,20 +6,18 @@
 
 namespace pullout::freespace_detail {
 
-Pose2 drive(const Pose2& from, double curvature, double distance) {
-  const double c = std::cos(from.yaw);
-  const double s = std::sin(from.yaw);
-  if (std::abs(curvature) < 1e-12) return {from.x + distance * c, from.y + distance * s, from.yaw};
-  const double dyaw = curvature * distance;
-  const double r = 1.0 / curvature;
-  const double yaw = from.yaw + dyaw;
-  return {from.x + r * (std::sin(yaw) - s), from.y + r * (c - std::cos(yaw)), yaw};
-}
+Pose2 drive(const Pose2& from, double curvature, double distance) { return Arc(from, curvature).at(distance); }
 
 Arc::Arc(const Pose2& from, double curvature) : Arc(from, std::cos(from.yaw), std::sin(from.yaw), curvature) {}
 
 Arc::Arc(const Pose2& from, double cos_yaw, double sin_yaw, double curvature)
     : from_(from), cos_(cos_yaw), sin_(sin_yaw), curvature_(curvature) {}
+
+Pose2 Arc::at(double distance) const {
+  double c = 1.0;
+  double s = 0.0;
+  return at(distance, c, s);
+}
 
 Pose2 Arc::at(double distance, double& cos_yaw, double& sin_yaw) const {
   if (std::abs(curvature_) < 1e-12) {

@@ -26,6 +26,7 @@ class Arc {
   Arc(const Pose2& from, double cos_yaw, double sin_yaw, double curvature);
   // The pose after `distance` [m] (negative: reverse), with cos and sin of its heading.
   Pose2 at(double distance, double& cos_yaw, double& sin_yaw) const;
+  Pose2 at(double distance) const;
   double curvature() const { return curvature_; }
 
  private:
