@@ -30,7 +30,7 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
   // Each edge adds its exact x range within every row strip it crosses; a convex polygon's extent
   // in a strip is the union of its edges' ranges there (a strip that cuts the polygon cuts its
   // boundary on both sides). The ranges live on the stack unless the piece is unusually tall.
-  std::array<double, 2 * kMaxRows> stack;
+  std::array<double, 2 * static_cast<std::size_t>(kMaxRows)> stack;
   std::vector<double> heap;
   double* lo = stack.data();
   if (rows > kMaxRows) {
