@@ -18,7 +18,7 @@
 #include <random>
 #include <vector>
 
-#include "pullout/collision/footprint.hpp"
+#include "lot_shapes.hpp"
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
@@ -29,14 +29,7 @@ using pullout::Pose2;
 
 constexpr double kPi = 3.14159265358979323846;
 
-// A length x width box centred on (cx, cy), turned by yaw: a parked car or a wall.
-pullout::Polygon box(double cx, double cy, double yaw, double length, double width) {
-  pullout::Object o;
-  o.pose = {cx, cy, yaw};
-  o.length_m = length;
-  o.width_m = width;
-  return pullout::object_polygon(o);
-}
+using pullout::bench::box;
 
 // A square lot `size` m across: 0.4 m walls, rows of 2.7 m x 5.5 m bays (double rows between 7 m
 // aisles), 70 % of the bays holding a 4.6 m x 1.9 m car (as bench_freespace's lots).

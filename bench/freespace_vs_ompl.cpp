@@ -40,7 +40,7 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
-#include "pullout/collision/footprint.hpp"
+#include "lot_shapes.hpp"
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/freespace/hybrid_astar.hpp"
@@ -69,14 +69,7 @@ struct Problem {
   Pose2 goal;
 };
 
-// A length x width box centred on (cx, cy), turned by yaw: a parked car or a wall.
-pullout::Polygon box(double cx, double cy, double yaw, double length, double width) {
-  pullout::Object o;
-  o.pose = {cx, cy, yaw};
-  o.length_m = length;
-  o.width_m = width;
-  return pullout::object_polygon(o);
-}
+using pullout::bench::box;
 
 // A bay: its centre and the direction its opening faces (+1: the aisle is above, -1: below).
 struct Bay {
