@@ -17,6 +17,7 @@
 #include "pullout/pipeline/deadline.hpp"
 #include "pullout/pipeline/parameters.hpp"
 #include "pullout/pipeline/start_planner.hpp"
+#include "pullout/session/vehicle_session.hpp"
 #include "report.hpp"
 #include "svg_writer.hpp"
 #include "text_output.hpp"
@@ -115,8 +116,22 @@ int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
   // The service's budget rule: the request's deadline, else the configured default.
   const double budget_ms =
       scenario.request.deadline_ms > 0.0 ? scenario.request.deadline_ms : config.service.default_deadline_ms;
-  const PlanningResult result = planner.plan(scenario.request, Deadline::after_ms(budget_ms));
-  return emit(make_report(result), scenario, options.scenario_file, options.output, out, err);
+  // The same session the service runs: what is printed is the first status the vehicle would get
+  // after planning (with the safety verdict at the start pose), not a summary of the search.
+  PullOutRequest request = scenario.request;
+  if (request.vehicle_id.empty()) request.vehicle_id = kDefaultVehicleId;
+  VehicleSession session(request.vehicle_id, planner);
+  const auto now = SteadyClock::now();
+  SessionEffects effects = session.on_request(request, {}, now);
+  if (effects.search) {
+    const PlanningResult result = planner.plan(effects.search->request, Deadline::after_ms(budget_ms));
+    effects = session.on_result(effects.search->sequence, result, now);
+  }
+  if (!effects.status) {
+    err << "pullout: internal error: the session published no status\n";
+    return kExitInternal;
+  }
+  return emit(make_report(effects.path, *effects.status), scenario, options.scenario_file, options.output, out, err);
 }
 
 int run_request(const RequestOptions& options, std::ostream& out, std::ostream& err) {

@@ -38,7 +38,7 @@ void expect_found_path_invariants(const PullOutPath& path);
 
 // One odometry sample of the vehicle executing request `request_id`.
 ExecutionProgress progress_sample(std::uint64_t request_id, std::int64_t stamp_ns, const Pose2& pose,
-                                  double velocity_mps, bool approved = true);
+                                  double velocity_mps, bool approved);
 
 class ServiceTest : public ::testing::Test {
  protected:

@@ -3,6 +3,7 @@
 // naming route lanelets is answered with a path, a bad route is rejected naming the field, and a
 // malformed map file stops the service at start-up with one line.
 #include <chrono>
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -75,6 +76,38 @@ TEST_F(MapService, RouteRequestIsAnsweredAndABadRouteIsRejectedNamingTheField) {
   const auto path_again = other->wait_for_path(again, kReplyTimeout);
   ASSERT_TRUE(path_again);
   EXPECT_TRUE(path_again->found);
+}
+
+// A route request is checked for traffic on the lanes picked on the map (the service used to build
+// its safety check from the request's inline lanes, which a route request does not have).
+TEST_F(MapService, ARouteRequestHoldsForAFastCarFromBehind) {
+  start_service(map_config());
+  const Scenario scenario = load_test_scenario("map_traffic_fast_from_behind");
+  ASSERT_TRUE(scenario.request.lanes.empty());
+  auto client = connect("int-map-traffic");
+  ASSERT_NE(client, nullptr);
+  const std::uint64_t id = client->send(scenario.request);
+  const auto path = client->wait_for_path(id, kReplyTimeout);
+  ASSERT_TRUE(path && path->found) << service_stderr();
+  // The first status already carries the verdict at the start.
+  const auto waiting = client->wait_for_status(
+      id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingApproval); }, kReplyTimeout);
+  ASSERT_TRUE(waiting);
+  EXPECT_FALSE(waiting->safe);
+  EXPECT_EQ(waiting->unsafe_object_id, 21);
+  // Approved: held for the car, never executing.
+  const Pose2 start = path->partial_paths.front().points.front().pose;
+  std::int64_t stamp = 1'000'000'000;
+  std::optional<PullOutStatus> held;
+  for (int i = 0; i < 50 && !held; ++i) {
+    stamp += 50'000'000;
+    client->report_progress(progress_sample(id, stamp, start, 0.0, true));
+    held = client->wait_for_status(
+        id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kWaitingSafety); }, 50ms);
+  }
+  ASSERT_TRUE(held) << "approved, but not held for the car behind";
+  EXPECT_EQ(held->unsafe_object_id, 21);
+  EXPECT_FALSE(held->departed);
 }
 
 TEST(ServiceStartup, RefusesAMalformedMapWithOneLine) {

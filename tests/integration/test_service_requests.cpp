@@ -60,18 +60,15 @@ TEST_F(PullOutFlow, StraightShoulderIsPlannedAndExecutedToCompletion) {
   EXPECT_FALSE(executing->evaluation_table.empty());
   EXPECT_EQ(client->current_segment(), std::optional<std::uint32_t>(0u));
 
-  // Drive along the path: one odometry sample per path point, the stamps advancing as a vehicle
-  // at the path's velocity would take (at least 0.5 m/s so it never stands still).
+  // Drive along the path: one odometry sample per path point.
   const auto& points = path->partial_paths[0].points;
   std::int64_t stamp_ns = system_now_ns();
   bool past_end = false;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (i > 0) {
-      const double ds = std::hypot(points[i].pose.x - points[i - 1].pose.x, points[i].pose.y - points[i - 1].pose.y);
-      const double v = std::max(std::abs(points[i].longitudinal_velocity_mps), 0.5);
-      stamp_ns += static_cast<std::int64_t>(ds / v * 1e9);
-    }
-    client->report_progress(progress_sample(id, stamp_ns, points[i].pose, points[i].longitudinal_velocity_mps));
+    // 20 ms per point on the vehicle's clock: a burst must not run ahead of the service's clock by
+    // more than the session's stamp tolerance (kMaxStampLead).
+    if (i > 0) stamp_ns += 20'000'000;
+    client->report_progress(progress_sample(id, stamp_ns, points[i].pose, points[i].longitudinal_velocity_mps, true));
     past_end = past_end || ahead_of(path->end_pose, points[i].pose) >= 0.0;
     const auto latest = client->latest_status();
     ASSERT_TRUE(latest);
@@ -97,6 +94,7 @@ TEST_F(PullOutFlow, StraightShoulderIsPlannedAndExecutedToCompletion) {
     standing.stamp_ns = stamp_ns;
     standing.pose = points.back().pose;
     standing.velocity_mps = 0.0;
+    standing.approved = true;
     client->report_progress(standing);
   }
   ASSERT_TRUE(completed) << "no COMPLETED status after driving past end_pose";

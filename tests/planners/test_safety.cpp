@@ -282,16 +282,19 @@ class TrafficScenarios : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(TrafficScenarios, SafetyVerdictMatchesTheFile) {
   const Scenario sc = load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/" + GetParam() + ".yaml");
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters, {}, sc.map).plan(sc.request, Deadline());
   ASSERT_TRUE(r.path.found) << r.stop_reason;
   ASSERT_TRUE(sc.expect.safe.has_value());
-  SafetyMonitor m(sc.parameters, sc.vehicle, sc.request.lanes, sc.request.objects, r.path);
+  ASSERT_NE(r.world, nullptr);
+  // The monitor sees exactly the world the path was planned on (for a route: the map's lanes).
+  SafetyMonitor m(sc.parameters, sc.vehicle, r.world->lanes, r.world->objects, r.path);
   const SafetyVerdict v = m.evaluate(sc.request.ego_pose, sc.request.ego_velocity_mps, 0, false);
   EXPECT_EQ(v.safe, *sc.expect.safe) << v.reason;
 }
 
 INSTANTIATE_TEST_SUITE_P(Bundled, TrafficScenarios,
-                         ::testing::Values("traffic_fast_from_behind", "traffic_far_behind", "traffic_cannot_pass"));
+                         ::testing::Values("traffic_fast_from_behind", "traffic_far_behind", "traffic_cannot_pass",
+                                           "map_traffic_fast_from_behind"));
 
 TEST(TrafficScenarios, CannotPassIsTheBypassNotTheCheck) {
   const Scenario sc = load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/traffic_cannot_pass.yaml");

@@ -1,5 +1,6 @@
 #include "pullout/pipeline/execution_tracker.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "pullout/geometry/polyline.hpp"
@@ -31,31 +32,36 @@ void ExecutionTracker::start(const PullOutPath& path) {
   path_ = path;
   current_path_idx_ = 0;
   completed_ = false;
-  stopped_since_ns_.reset();
+  stopped_since_.reset();
 }
 
 void ExecutionTracker::clear() {
   path_.reset();
   current_path_idx_ = 0;
   completed_ = false;
-  stopped_since_ns_.reset();
+  stopped_since_.reset();
 }
 
 void ExecutionTracker::adopt(std::uint64_t request_id) {
   if (path_) path_->request_id = request_id;
 }
 
-ExecutionTracker::Update ExecutionTracker::on_progress(const ExecutionProgress& progress) {
+ExecutionTracker::Update ExecutionTracker::on_progress(const ExecutionProgress& progress,
+                                                       std::chrono::steady_clock::time_point received) {
   Update u{false, current_path_idx_, completed_};
   if (!path_ || progress.request_id != path_->request_id || completed_ || path_->partial_paths.empty()) return u;
 
   if (std::abs(progress.velocity_mps) < th_stopped_velocity_) {
-    if (!stopped_since_ns_) stopped_since_ns_ = progress.stamp_ns;
+    if (!stopped_since_) stopped_since_ = Since{progress.stamp_ns, received};
   } else {
-    stopped_since_ns_.reset();
+    stopped_since_.reset();
   }
-  const bool stopped_long_enough =
-      stopped_since_ns_ && static_cast<double>(progress.stamp_ns - *stopped_since_ns_) * 1e-9 >= th_stopped_time_;
+  bool stopped_long_enough = false;
+  if (stopped_since_) {
+    const double on_stamps = static_cast<double>(progress.stamp_ns - stopped_since_->stamp_ns) * 1e-9;
+    const double on_clock = std::chrono::duration<double>(received - stopped_since_->received).count();
+    stopped_long_enough = std::min(on_stamps, on_clock) >= th_stopped_time_;
+  }
 
   const auto last = static_cast<std::uint32_t>(path_->partial_paths.size() - 1);
   const Vec2 p = to_vec(progress.pose);
@@ -64,7 +70,7 @@ ExecutionTracker::Update ExecutionTracker::on_progress(const ExecutionProgress& 
     const Vec2 end = to_vec(segment.points.back().pose);
     if ((p - end).norm() < th_arrived_distance_ && stopped_long_enough) {
       ++current_path_idx_;
-      stopped_since_ns_.reset();
+      stopped_since_.reset();
       u.changed = true;
     }
   } else {

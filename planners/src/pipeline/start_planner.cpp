@@ -204,7 +204,12 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
 PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline& deadline) const {
   const auto t0 = std::chrono::steady_clock::now();
   PlanningResult result;
+  const std::vector<Lane>* planned_lanes = nullptr;  // the lanes planned on, once known
   const auto finish = [&](PlanningResult& r) {
+    if (r.outcome != PlanningResult::Outcome::kRejected) {
+      r.world = std::make_shared<const PlannedWorld>(
+          PlannedWorld{planned_lanes != nullptr ? *planned_lanes : std::vector<Lane>{}, request.objects});
+    }
     r.planning_time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     r.path.vehicle_id = request.vehicle_id;
     r.path.request_id = request.request_id;
@@ -230,6 +235,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     finish(result);
     return result;
   }
+  planned_lanes = lanes.lanes;
   const LaneWorld world(*lanes.lanes);
   if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) {
     result.issues.push_back(*issue);

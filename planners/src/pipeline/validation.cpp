@@ -125,6 +125,8 @@ void validate_object(Checker& c, const std::string& f, const Object& o, const Re
     if (!c.count(pf, pp.poses.size(), limits.max_predicted_path_points, "poses")) continue;
     if (c.finite(pf + ".time_step_s", pp.time_step_s) && pp.time_step_s <= 0.0)
       c.add(pf + ".time_step_s", "must be positive");
+    if (c.finite(pf + ".confidence", pp.confidence) && (pp.confidence < 0.0 || pp.confidence > 1.0))
+      c.add(pf + ".confidence", "must be in [0, 1]");
     for (std::size_t i = 0; i < pp.poses.size(); ++i) {
       if (!c.pose(pf + ".poses[" + std::to_string(i) + "]", pp.poses[i])) break;
     }

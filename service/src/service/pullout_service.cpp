@@ -22,7 +22,9 @@ namespace {
 
 // The dispatcher also wakes this often without any event, so that a missed wake-up (which should
 // not happen) costs at most this much latency rather than a stuck vehicle.
-const eprosima::fastrtps::Duration_t kDispatcherWakePeriod{1, 0};
+// It is also the period of the sessions' on_time (the odometry watchdog).
+const eprosima::fastrtps::Duration_t kDispatcherWakePeriod{0, 250'000'000};
+constexpr auto kSessionTimePeriod = std::chrono::milliseconds(250);
 constexpr auto kProgressWarnInterval = std::chrono::seconds(5);
 // Must match the generated key buffer (see convert.cpp): replies to a longer id cannot be written.
 constexpr std::size_t kMaxVehicleIdBytes = 255;
@@ -45,7 +47,7 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
     : config_(config),
       dds_(config.dds),
       planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
-      registry_(config.vehicle, config.start_planner, dds_) {
+      registry_(planner_, dds_) {
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
 }
 
@@ -84,6 +86,7 @@ void PulloutService::dispatch_loop() {
   waitset.attach_condition(shutdown_);
   spdlog::debug("dispatcher running");
 
+  auto last_time_tick = std::chrono::steady_clock::now();
   while (!stopping_) {
     dds::ConditionSeq active;
     const auto rc = waitset.wait(active, kDispatcherWakePeriod);
@@ -95,6 +98,11 @@ void PulloutService::dispatch_loop() {
     // Both readers are drained on every wake-up: cheap when empty, and it cannot miss data.
     take_requests();
     take_progress();
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_time_tick >= kSessionTimePeriod) {
+      last_time_tick = now;
+      registry_.on_time();
+    }
   }
 
   // The conditions belong to the readers, which outlive this thread; detach before they go.
@@ -142,20 +150,18 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
   std::vector<RequestIssue> issues;
   PullOutRequest request = idl::from_msg(sample, issues);
   if (!issues.empty()) {
-    spdlog::warn("vehicle '{}' request {} rejected: {} problem(s), first: {}: {}", request.vehicle_id,
-                 request.request_id, issues.size(), issues.front().field, issues.front().problem);
-    registry_.reject(request.vehicle_id, request.request_id, issues);
+    registry_.on_request(std::move(request), issues);
     return;
   }
   if (request.route_lanelet_ids.empty()) {
-    spdlog::info("vehicle '{}' request {}: accepted ({} lanes, {} objects)", request.vehicle_id, request.request_id,
+    spdlog::info("vehicle '{}' request {}: received ({} lanes, {} objects)", request.vehicle_id, request.request_id,
                  request.lanes.size(), request.objects.size());
   } else {
-    spdlog::info("vehicle '{}' request {}: accepted (route of {} lanelets, {} objects)", request.vehicle_id,
+    spdlog::info("vehicle '{}' request {}: received (route of {} lanelets, {} objects)", request.vehicle_id,
                  request.request_id, request.route_lanelet_ids.size(), request.objects.size());
   }
-  std::optional<PlanningJob> job = registry_.accept(std::move(request));
-  if (!job) return;  // objects of a latched path updated
+  std::optional<PlanningJob> job = registry_.on_request(std::move(request), {});
+  if (!job) return;  // rejected, or only the objects of the followed path updated
   const std::string vehicle = job->request.vehicle_id;
   if (queue_->push(std::move(*job))) {
     spdlog::debug("vehicle '{}': a waiting request was replaced by a newer one", vehicle);
@@ -191,15 +197,11 @@ void PulloutService::run_job(PlanningJob& job) {
     result = planner_.plan(request, deadline);
   } catch (const std::exception& e) {
     spdlog::error("vehicle '{}' request {}: planner failed: {}", request.vehicle_id, request.request_id, e.what());
-    if (!stopping_) registry_.fail(job, e.what());
+    if (!stopping_) registry_.on_search_failed(job, e.what());
     return;
   }
   if (stopping_) return;  // a search cut short by shutdown is not a "no path"
-  if (!registry_.complete(job, result)) {
-    spdlog::debug("vehicle '{}' request {}: result dropped, a newer request arrived", request.vehicle_id,
-                  request.request_id);
-    return;
-  }
+  registry_.on_result(job, result);
   if (result.outcome == PlanningResult::Outcome::kFound) {
     spdlog::info("vehicle '{}' request {}: {} path, {} segment(s), {:.1f} ms (+{:.1f} ms queued)", request.vehicle_id,
                  request.request_id, to_string(result.path.planner_type), result.path.partial_paths.size(),

@@ -211,7 +211,9 @@ struct ExecutionProgress {
   std::int64_t stamp_ns{0};  // [ns] time of the odometry sample
   Pose2 pose;
   double velocity_mps{0.0};
-  bool approved{true};
+  // The vehicle (its driver or its supervisor) approves departure on this path. Never the
+  // default: a vehicle that does not say so explicitly waits in kWaitingApproval.
+  bool approved{false};
 };
 
 }  // namespace pullout

@@ -36,6 +36,13 @@ class LaneletMap;
 // "field: problem" lines joined by '\n'.
 std::string format_issues(const std::vector<RequestIssue>& issues);
 
+// The world a search planned on: the lanes (the request's inline lanes, or those picked on the map
+// for its route) and the request's objects. The safety checks of a found path use exactly these.
+struct PlannedWorld {
+  std::vector<Lane> lanes;
+  std::vector<Object> objects;
+};
+
 struct PlanningResult {
   enum class Outcome { kFound, kNoPath, kRejected };
   Outcome outcome{Outcome::kNoPath};
@@ -47,6 +54,8 @@ struct PlanningResult {
   std::vector<RequestIssue> issues;              // kRejected
   bool timed_out{false};
   double planning_time_ms{0.0};
+  // kFound and kNoPath: what was planned on (lanes empty for a grid-only request). Null: kRejected.
+  std::shared_ptr<const PlannedWorld> world;
 };
 
 class StartPlanner {
