@@ -6,6 +6,7 @@
 #include <deque>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -29,6 +30,7 @@
 
 #include "dds_qos.hpp"
 #include "pullout/idl/convert.hpp"
+#include "pullout/idl/guarded_type.hpp"
 #include "pullout/msg/pulloutPubSubTypes.h"
 #include "vehicle_filter.hpp"
 
@@ -88,6 +90,15 @@ struct Received {
   std::shared_ptr<const T> value;
 };
 
+// A registered callback and its delivery state, guarded by Impl::callback_mutex_.
+template <typename T>
+struct CallbackSlot {
+  std::function<void(const T&)> callback;
+  std::uint64_t generation{0};          // incremented by every registration (the first is 1)
+  std::uint64_t delivered_seq{0};       // last seq given to the current callback
+  std::uint64_t running_generation{0};  // generation of the callback the dispatcher is in; 0: none
+};
+
 template <typename T>
 void push_bounded(std::deque<Received<T>>& queue, Received<T> item, std::size_t bound) {
   queue.push_back(std::move(item));
@@ -126,6 +137,10 @@ class __attribute__((visibility("hidden"))) Client::Impl {
 
   void run();
   void dispatch_once();
+  template <typename T>
+  void replace_callback(CallbackSlot<T>& slot, std::function<void(const T&)> callback);
+  template <typename T>
+  bool deliver(CallbackSlot<T>& slot, const Received<T>& item, std::uint64_t generation, const char* what);
   std::vector<std::shared_ptr<const PullOutPath>> take_paths();
   std::vector<std::shared_ptr<const PullOutStatus>> take_statuses();
   bool on_dispatcher_thread() const { return std::this_thread::get_id() == dispatcher_.get_id(); }
@@ -155,12 +170,12 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   std::uint64_t current_request_id_{0};
   bool sent_any_{false};
 
-  // --- callbacks, guarded by callback_mutex_, which the dispatcher holds while it delivers ---
+  // --- callbacks, guarded by callback_mutex_ (never held while a callback runs). Lock order:
+  // callback_mutex_, then state_mutex_. callback_cv_ signals the end of a callback. ---
   std::mutex callback_mutex_;
-  PathCallback path_callback_;
-  StatusCallback status_callback_;
-  std::uint64_t path_delivered_seq_{0};    // last path seq given to the current path callback
-  std::uint64_t status_delivered_seq_{0};  // same for statuses
+  std::condition_variable callback_cv_;
+  CallbackSlot<PullOutPath> path_slot_;
+  CallbackSlot<PullOutStatus> status_slot_;
 
   dds::GuardCondition wake_;
   std::atomic<bool> stop_{false};
@@ -231,14 +246,16 @@ void Client::Impl::create_entities() {
     if (topic == nullptr) throw ClientError(std::string("cannot create topic ") + name);
     return topic;
   };
+  // Guarded: a malformed reply fails to deserialize (and is dropped) instead of throwing out of
+  // take_next_sample on the client's thread.
   dds::Topic* request_topic = create_topic(client_detail::kRequestTopic,
-                                           register_type(std::make_unique<msg::PullOutRequestPubSubType>().release()));
-  dds::Topic* progress_topic = create_topic(
-      client_detail::kProgressTopic, register_type(std::make_unique<msg::ExecutionProgressPubSubType>().release()));
+                                           register_type(idl::make_guarded_type<msg::PullOutRequestPubSubType>()));
+  dds::Topic* progress_topic = create_topic(client_detail::kProgressTopic,
+                                            register_type(idl::make_guarded_type<msg::ExecutionProgressPubSubType>()));
   dds::Topic* path_topic =
-      create_topic(client_detail::kPathTopic, register_type(std::make_unique<msg::PullOutPathPubSubType>().release()));
-  dds::Topic* status_topic = create_topic(client_detail::kStatusTopic,
-                                          register_type(std::make_unique<msg::PullOutStatusPubSubType>().release()));
+      create_topic(client_detail::kPathTopic, register_type(idl::make_guarded_type<msg::PullOutPathPubSubType>()));
+  dds::Topic* status_topic =
+      create_topic(client_detail::kStatusTopic, register_type(idl::make_guarded_type<msg::PullOutStatusPubSubType>()));
 
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
@@ -346,26 +363,29 @@ void Client::Impl::report_progress(ExecutionProgress progress) {
 // ------------------------------------------------------------------------------------------------
 // Callbacks and the client's thread
 
-void Client::Impl::on_path(PathCallback callback) {
+template <typename T>
+void Client::Impl::replace_callback(CallbackSlot<T>& slot, std::function<void(const T&)> callback) {
+  std::function<void(const T&)> previous;  // destroyed after the lock is released
   {
-    // From a callback the dispatcher already holds callback_mutex_.
-    std::unique_lock<std::mutex> lock(callback_mutex_, std::defer_lock);
-    if (!on_dispatcher_thread()) lock.lock();
-    path_callback_ = std::move(callback);
-    path_delivered_seq_ = 0;
+    std::unique_lock<std::mutex> lock(callback_mutex_);
+    previous = std::move(slot.callback);
+    slot.callback = std::move(callback);
+    ++slot.generation;
+    slot.delivered_seq = 0;
+    // From another thread: return only once a running previous callback has returned. From a
+    // callback (the dispatcher), that callback is the one running: it takes effect next delivery.
+    // (A later callback that has started meanwhile is not waited for.)
+    const std::uint64_t mine = slot.generation;
+    if (!on_dispatcher_thread()) {
+      callback_cv_.wait(lock, [&] { return slot.running_generation == 0 || slot.running_generation >= mine; });
+    }
   }
-  wake_dispatcher();  // replays the latest path to the new callback
+  wake_dispatcher();  // replays the latest sample to the new callback
 }
 
-void Client::Impl::on_status(StatusCallback callback) {
-  {
-    std::unique_lock<std::mutex> lock(callback_mutex_, std::defer_lock);
-    if (!on_dispatcher_thread()) lock.lock();
-    status_callback_ = std::move(callback);
-    status_delivered_seq_ = 0;
-  }
-  wake_dispatcher();
-}
+void Client::Impl::on_path(PathCallback callback) { replace_callback(path_slot_, std::move(callback)); }
+
+void Client::Impl::on_status(StatusCallback callback) { replace_callback(status_slot_, std::move(callback)); }
 
 void Client::Impl::run() {
   dds::WaitSet waitset;
@@ -418,63 +438,81 @@ std::vector<std::shared_ptr<const PullOutStatus>> Client::Impl::take_statuses() 
   return out;
 }
 
+// Invokes the slot's callback with item, unless it was already given to it. Returns false when a
+// callback was registered since `generation` was read: the rest of the batch is left to the next
+// round, which replays the latest sample to the new callback.
+template <typename T>
+bool Client::Impl::deliver(CallbackSlot<T>& slot, const Received<T>& item, std::uint64_t generation, const char* what) {
+  std::function<void(const T&)> callback;
+  {
+    std::lock_guard<std::mutex> lock(callback_mutex_);
+    if (slot.generation != generation) return false;
+    if (!slot.callback || item.seq <= slot.delivered_seq) return true;
+    slot.delivered_seq = item.seq;
+    callback = slot.callback;  // a copy: the callback may replace itself
+    slot.running_generation = generation;
+  }
+  try {
+    callback(*item.value);
+  } catch (const std::exception& e) {
+    EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the " << what << " callback threw: " << e.what());
+  } catch (...) {
+    EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the " << what << " callback threw a non-standard exception");
+  }
+  callback = nullptr;  // the copy goes before running_generation is cleared
+  {
+    std::lock_guard<std::mutex> lock(callback_mutex_);
+    slot.running_generation = 0;
+  }
+  callback_cv_.notify_all();
+  return true;
+}
+
 void Client::Impl::dispatch_once() {
   auto paths = take_paths();
   auto statuses = take_statuses();
 
-  // Held across the state update and the deliveries, so that on_path/on_status (which take it)
-  // see each sample either as already delivered to the old callback or as still to deliver.
-  std::lock_guard<std::mutex> callbacks(callback_mutex_);
   std::vector<Received<PullOutPath>> path_out;
   std::vector<Received<PullOutStatus>> status_out;
+  std::uint64_t path_generation = 0;
+  std::uint64_t status_generation = 0;
   {
+    // Both locks, so that a registration sees each sample either as gathered for delivery here
+    // (with the generation read here) or as still to replay.
+    std::lock_guard<std::mutex> callbacks(callback_mutex_);
     std::lock_guard<std::mutex> lock(state_mutex_);
+    path_generation = path_slot_.generation;
+    status_generation = status_slot_.generation;
     // Replay of the latest sample to a newly registered callback.
-    if (path_callback_ && !recent_paths_.empty() && recent_paths_.back().seq > path_delivered_seq_) {
+    if (path_slot_.callback && !recent_paths_.empty() && recent_paths_.back().seq > path_slot_.delivered_seq) {
       path_out.push_back(recent_paths_.back());
     }
-    if (status_callback_ && !recent_statuses_.empty() && recent_statuses_.back().seq > status_delivered_seq_) {
+    if (status_slot_.callback && !recent_statuses_.empty() &&
+        recent_statuses_.back().seq > status_slot_.delivered_seq) {
       status_out.push_back(recent_statuses_.back());
     }
     for (auto& path : paths) {
       // Before the first send(), follow the request the service last answered (restart case).
       if (!sent_any_) current_request_id_ = path->request_id;
       Received<PullOutPath> item{++path_seq_, std::move(path)};
-      if (path_callback_) path_out.push_back(item);
+      if (path_slot_.callback) path_out.push_back(item);
       push_bounded(recent_paths_, std::move(item), kRecentPaths);
     }
     for (auto& status : statuses) {
       Received<PullOutStatus> item{++status_seq_, std::move(status)};
-      if (status_callback_) status_out.push_back(item);
+      if (status_slot_.callback) status_out.push_back(item);
       push_bounded(recent_statuses_, std::move(item), kRecentStatuses);
     }
   }
   if (!paths.empty() || !statuses.empty()) state_cv_.notify_all();
 
-  // Paths first: a status announcing execution refers to a path the callback has seen.
+  // No lock is held while a callback runs. Paths first: a status announcing execution refers to a
+  // path the callback has seen.
   for (const auto& item : path_out) {
-    if (!path_callback_ || item.seq <= path_delivered_seq_) continue;
-    path_delivered_seq_ = item.seq;
-    PathCallback callback = path_callback_;  // the callback may replace itself
-    try {
-      callback(*item.value);
-    } catch (const std::exception& e) {
-      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the path callback threw: " << e.what());
-    } catch (...) {
-      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the path callback threw a non-standard exception");
-    }
+    if (!deliver(path_slot_, item, path_generation, "path")) break;
   }
   for (const auto& item : status_out) {
-    if (!status_callback_ || item.seq <= status_delivered_seq_) continue;
-    status_delivered_seq_ = item.seq;
-    StatusCallback callback = status_callback_;
-    try {
-      callback(*item.value);
-    } catch (const std::exception& e) {
-      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the status callback threw: " << e.what());
-    } catch (...) {
-      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "the status callback threw a non-standard exception");
-    }
+    if (!deliver(status_slot_, item, status_generation, "status")) break;
   }
 }
 

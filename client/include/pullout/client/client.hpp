@@ -18,11 +18,15 @@
 // Threading: every member function is thread-safe. Samples are taken from DDS and callbacks are
 // invoked on one thread owned by the client (not a DDS listener thread), one at a time, in arrival
 // order, with no internal lock held, so a callback may call any member function except the
-// destructor. A slow callback delays later callbacks, not the blocking waits (state is updated
-// before callbacks run). Callbacks must not throw; an exception escaping a callback is caught and
-// reported through the Fast DDS log (category "PULLOUT_CLIENT"). A blocking wait called from a
-// callback only sees what was received before that callback (the thread that would deliver newer
-// samples is the one running the callback), so it times out rather than seeing new replies.
+// destructor, and may wait for another thread that uses the client, with one exception: on_path
+// (on_status) called from another thread waits for a running path (status) callback to return, so
+// a path callback must not wait for a thread that calls on_path (same for status). A slow
+// callback delays later callbacks, not the blocking waits (state is updated before callbacks
+// run). Callbacks must not throw; an exception escaping a callback is caught and reported through
+// the Fast DDS log (category "PULLOUT_CLIENT"). A blocking wait called from a callback only sees
+// what was received before that callback (the thread that would deliver newer samples is the one
+// running the callback), so it times out rather than seeing new replies. Undecodable replies are
+// dropped by the type support (they never reach a callback nor a wait).
 //
 // Lifetime: the destructor stops the client's thread (waiting for a running callback to return),
 // then deletes every DDS entity. Do not destroy a Client from one of its callbacks, nor while
@@ -99,8 +103,9 @@ class PULLOUT_CLIENT_EXPORT Client {
   // an empty function unregisters. If a path (status) was already received, the new callback is
   // first invoked once with the latest one, then with every later one. Invoked on the client's
   // thread. When on_path returns (called from any other thread), the previous callback is not
-  // running and will not be invoked again; called from inside a callback, it takes effect for the
-  // next delivery.
+  // running and will not be invoked again: on_path blocks while it runs (on_status only waits for
+  // a status callback, on_path only for a path callback). Called from inside a callback, it does
+  // not block and takes effect for the next delivery.
   void on_path(PathCallback callback);
   void on_status(StatusCallback callback);
 
