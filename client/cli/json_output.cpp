@@ -16,16 +16,31 @@ Json number(const std::optional<double>& v) { return v ? number(*v) : Json(nullp
 
 Json pose(const Pose2& p) { return Json{{"x", number(p.x)}, {"y", number(p.y)}, {"yaw", number(p.yaw)}}; }
 
+// Every point of partial path k: pose and signed longitudinal velocity.
+Json segment_points(const PlanReport& report, std::size_t k) {
+  Json points = Json::array();
+  if (!report.path || k >= report.path->partial_paths.size()) return points;
+  for (const PathPoint& p : report.path->partial_paths[k].points) {
+    points.push_back({{"x", number(p.pose.x)},
+                      {"y", number(p.pose.y)},
+                      {"yaw", number(p.pose.yaw)},
+                      {"velocity", number(p.longitudinal_velocity_mps)}});
+  }
+  return points;
+}
+
 }  // namespace
 
 nlohmann::ordered_json to_json(const PlanReport& report) {
   Json segments = Json::array();
-  for (const auto& s : report.segments) {
+  for (std::size_t k = 0; k < report.segments.size(); ++k) {
+    const SegmentSummary& s = report.segments[k];
     segments.push_back({{"points", s.points},
                         {"direction", s.reverse ? "reverse" : "forward"},
                         {"terminal_velocity", number(s.terminal_velocity_mps)},
                         {"terminal_acceleration", number(s.terminal_accel_mps2)},
-                        {"length", number(s.length_m)}});
+                        {"length", number(s.length_m)},
+                        {"path", segment_points(report, k)}});
   }
   Json table = Json::array();
   for (const auto& a : report.evaluation_table) {

@@ -11,13 +11,16 @@
 //     "safe": true,                            // dynamic safety at the last progress sample
 //     "segments": [{"points": 42, "direction": "forward" | "reverse",
 //                   "terminal_velocity": 2.7, "terminal_acceleration": 0.0,   // null if unknown
-//                   "length": 40.1}],          // [m/s], [m/s^2], [m]
+//                   "length": 40.1,            // [m/s], [m/s^2], [m]
+//                   "path": [{"x": 10.0, "y": 3.25, "yaw": 0.0, "velocity": 2.7}, ...]}],
+//                                              // every point ("points" of them), in driving
+//                                              // order: [m], [rad], [m/s] (negative reversing)
 //     "start_pose": {"x": 0.0, "y": 0.0, "yaw": 0.0},   // [m], [rad]; null without a path
 //     "end_pose":   {"x": 0.0, "y": 0.0, "yaw": 0.0},
 //     "evaluation_table": [{"planner": "shift", "margin": 2.0, "backward_distance": 0.0,
 //                           "outcome": "collision"}],   // [m]
 //     "planning_time_ms": 3.2,
-//     "reasons": ["..."],                      // why nothing was found; [] when found
+//     "reasons": ["..."],                      // why nothing was found; found: how the path ends
 //     "error": ""                              // rejected: "<field>: <problem>" lines
 //   }
 //

@@ -82,8 +82,9 @@ PlanReport make_report(const PlanningResult& result) {
     report.planner = result.path.planner_type;
     report.segments = summarize_segments(result.path);
   }
+  // A found path's reasons are notes on how it ends (where it stops before an object).
+  for (const auto& reason : result.path.reasons) add_reason(report.reasons, reason);
   if (!report.found) {
-    for (const auto& reason : result.path.reasons) add_reason(report.reasons, reason);
     add_reason(report.reasons, result.stop_reason);
     if (result.timed_out) add_reason(report.reasons, "planning deadline expired");
   }
@@ -109,9 +110,7 @@ PlanReport make_report(const std::optional<PullOutPath>& path, const PullOutStat
     report.found = path->found && has_path(status.state);
     if (path->planner_type != PlannerType::kNone) report.planner = path->planner_type;
     report.segments = summarize_segments(*path);
-    if (!report.found) {
-      for (const auto& reason : path->reasons) add_reason(report.reasons, reason);
-    }
+    for (const auto& reason : path->reasons) add_reason(report.reasons, reason);
   }
   if (!report.found) add_reason(report.reasons, status.stop_reason);
   return report;

@@ -40,7 +40,7 @@ struct PlanReport {
   std::vector<SegmentSummary> segments;  // one per partial path of `path`
   std::vector<PlannerAttempt> evaluation_table;
   double planning_time_ms{0.0};
-  std::vector<std::string> reasons;  // why no path was found
+  std::vector<std::string> reasons;  // why no path was found; found: how the path ends
   std::string error;                 // rejected: "<field>: <problem>" lines
 };
 

@@ -67,6 +67,9 @@ void print_report(std::ostream& out, const PlanReport& report) {
     out << "start pose: " << pose_text(report.path->start_pose) << '\n';
     out << "end pose:   " << pose_text(report.path->end_pose) << '\n';
   }
+  if (report.found) {
+    for (const auto& note : report.reasons) print_lines(out, note, "path end: ");
+  }
 
   if (!report.evaluation_table.empty()) {
     const std::size_t n = report.evaluation_table.size();

@@ -113,6 +113,43 @@ TEST(JsonOutput, FoundPlanHasEveryField) {
   EXPECT_EQ(nlohmann::ordered_json::parse(j.dump()), j);
 }
 
+TEST(JsonOutput, SegmentsCarryEveryPointOfThePath) {
+  PullOutPath path = two_segment_path();
+  path.partial_paths[1].points[4].pose.yaw = 0.25;  // a value that differs from its neighbours
+  path.partial_paths[1].points[4].longitudinal_velocity_mps = 1.5;
+  const nlohmann::ordered_json j = to_json(make_report(path, PullOutStatus{}));
+  ASSERT_EQ(j["segments"].size(), path.partial_paths.size());
+  for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
+    const auto& points = path.partial_paths[k].points;
+    const auto& json_points = j["segments"][k]["path"];
+    ASSERT_TRUE(json_points.is_array()) << k;
+    ASSERT_EQ(json_points.size(), points.size()) << k;
+    EXPECT_EQ(j["segments"][k]["points"], points.size());  // the existing count stays
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      EXPECT_DOUBLE_EQ(json_points[i]["x"].get<double>(), points[i].pose.x) << k << "/" << i;
+      EXPECT_DOUBLE_EQ(json_points[i]["y"].get<double>(), points[i].pose.y) << k << "/" << i;
+      EXPECT_DOUBLE_EQ(json_points[i]["yaw"].get<double>(), points[i].pose.yaw) << k << "/" << i;
+      EXPECT_DOUBLE_EQ(json_points[i]["velocity"].get<double>(), points[i].longitudinal_velocity_mps) << k << "/" << i;
+    }
+  }
+  EXPECT_DOUBLE_EQ(j["segments"][0]["path"][3]["x"].get<double>(), 7.0);  // reversing from 10 to 7
+  EXPECT_DOUBLE_EQ(j["segments"][0]["path"][3]["velocity"].get<double>(), -1.0);
+  EXPECT_DOUBLE_EQ(j["segments"][1]["path"][4]["yaw"].get<double>(), 0.25);
+  // Survives a round trip through text.
+  EXPECT_EQ(nlohmann::json::parse(j.dump())["segments"][1]["path"].size(), 11u);
+}
+
+TEST(JsonOutput, FoundPathNotesOnHowItEndsAreReasons) {
+  PlanningResult result = found_result();
+  result.path.reasons = {"stops 2.00 m before object 7, 21.3 m beyond the end pose"};
+  const nlohmann::ordered_json j = to_json(make_report(result));
+  ASSERT_EQ(j["reasons"].size(), 1u);
+  EXPECT_EQ(j["reasons"][0], result.path.reasons[0]);
+  std::ostringstream out;
+  print_report(out, make_report(result));
+  EXPECT_NE(out.str().find("path end: stops 2.00 m before object 7"), std::string::npos) << out.str();
+}
+
 TEST(JsonOutput, NoPathCarriesReasonsAndStopReasonOnce) {
   PlanningResult result;
   result.outcome = PlanningResult::Outcome::kNoPath;

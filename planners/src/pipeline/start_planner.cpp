@@ -151,6 +151,28 @@ std::vector<std::string> no_path_reasons(const std::vector<PlannerAttempt>& atte
   return reasons;
 }
 
+// Every published point checked against the static objects; the path stops before the first one
+// beyond the end pose (published_path.hpp), and says how it ends.
+void publish_checked(PlanningResult& result, const ObjectChecker& objects, double margin,
+                     const StartPlannerParameters& params) {
+  const PublishedPathLimits limits{margin, params.stop_condition.maximum_deceleration_for_stop,
+                                   params.stop_condition.maximum_jerk_for_stop};
+  result.path_end = finish_published_path(result.path, objects, limits);
+  if (!result.path_end.note.empty()) result.path.reasons.push_back(result.path_end.note);
+}
+
+// The static objects of a grid-only request, for the final check of its path.
+ObjectChecker static_obstacle_checker(const PullOutRequest& request, const VehicleInfo& vehicle,
+                                      const StartPlannerParameters& params) {
+  std::vector<Obstacle> obstacles;
+  for (const Object& o : request.objects) {
+    if (std::abs(o.velocity_mps) >= params.th_moving_object_velocity) continue;
+    if (!params.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
+    obstacles.push_back({o.id, object_polygon(o)});
+  }
+  return ObjectChecker(vehicle_footprint(vehicle), std::move(obstacles));
+}
+
 }  // namespace
 
 bool planner_available(PlannerType type) {
@@ -191,6 +213,7 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
   if (r.status == HybridAStarResult::Status::kSuccess) {
     result.outcome = PlanningResult::Outcome::kFound;
     result.path = std::move(r.path);
+    publish_checked(result, static_obstacle_checker(request, vehicle_, parameters_), margin, parameters_);
     return result;
   }
   result.timed_out = r.status == HybridAStarResult::Status::kTimeout;
@@ -357,6 +380,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
           result.path.pairs_terminal_velocity_and_accel.insert(result.path.pairs_terminal_velocity_and_accel.begin(),
                                                                {v, -v * v / start.backward_distance});
         }
+        publish_checked(result, checker, margin, params);
         finish(result);
         return result;
       }
@@ -376,6 +400,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, sel.outcome});
     if (sel.chosen != nullptr) {
       accept(*sel.chosen, PlannerType::kFreespace);
+      publish_checked(result, checker, margin, params);
       finish(result);
       return result;
     }

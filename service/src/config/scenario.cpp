@@ -211,6 +211,8 @@ void read_expectation(MapReader& parent, ScenarioExpectation& out) {
   if (r.read("margin", margin)) out.margin_m = margin;
   bool safe = true;
   if (r.read("safe", safe)) out.safe = safe;
+  std::int64_t stop_object = 0;
+  if (r.read("stops_before_object", stop_object)) out.stops_before_object = stop_object;
   r.finish();
 }
 

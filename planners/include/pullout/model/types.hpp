@@ -154,7 +154,9 @@ struct PullOutPath {
   Pose2 end_pose;
   double shift_length_m{0.0};  // lateral offset of the start from the road centerline, left positive [m]
   TurnSignal turn_signal{TurnSignal::kNone};
-  std::vector<std::string> reasons;  // why nothing was found (found == false)
+  // found == false: why nothing was found. found == true: notes on how the published path ends
+  // (e.g. "stops 2.00 m before object 7, 21.3 m beyond the end pose", or that it is clear).
+  std::vector<std::string> reasons;
 };
 
 enum class ExecutionState : std::uint8_t {

@@ -27,6 +27,7 @@
 #include "pullout/model/types.hpp"
 #include "pullout/pipeline/deadline.hpp"
 #include "pullout/pipeline/parameters.hpp"
+#include "pullout/pipeline/published_path.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace pullout {
@@ -52,6 +53,9 @@ struct PlanningResult {
   std::vector<PlannerAttempt> evaluation_table;  // one row per attempt, in search order
   std::string stop_reason;                       // kNoPath: one line summary
   std::vector<RequestIssue> issues;              // kRejected
+  // kFound: how the published path ends (finish_published_path): where it stops before an object
+  // beyond the end pose, or that it is clear; `path_end.note` is also the last of path.reasons.
+  PublishedPathEnd path_end;
   bool timed_out{false};
   double planning_time_ms{0.0};
   // kFound and kNoPath: what was planned on (lanes empty for a grid-only request). Null: kRejected.

@@ -29,7 +29,9 @@
 //   vehicle_id: demo-1                        # optional
 //   description: "..."                        # optional, free text
 //   expect: {found: true, planner: shift, safe: true}   # optional, used by tests; safe: the
-//                                             # safety verdict at the start, before departure
+//                                             # safety verdict at the start, before departure;
+//                                             # stops_before_object: 7, the published path stops
+//                                             # before object 7 beyond the end pose
 #pragma once
 
 #include <memory>
@@ -49,6 +51,9 @@ struct ScenarioExpectation {
   std::optional<double> margin_m;  // the collision margin the winning attempt used
   // The dynamic safety verdict for the found path at the start, before departure (approved).
   std::optional<bool> safe;
+  // The published path is cut and stops (velocity 0) before this static object, beyond the end
+  // pose (`stops_before_object: 7`).
+  std::optional<std::int64_t> stops_before_object;
 };
 
 struct Scenario {
