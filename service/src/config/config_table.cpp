@@ -126,13 +126,12 @@ void check_value(const Choices& c, const std::string& v, const std::string& path
   out.push_back(path + ": unknown value '" + v + "' (expected " + describe(c).substr(7) + ")" + at);
 }
 
-void check_value(const NonEmpty&, const std::string& v, const std::string& path, const std::string& at,
-                 Problems& out) {
+void check_value(const NonEmpty&, const std::string& v, const std::string& path, const std::string& at, Problems& out) {
   if (v.empty()) out.push_back(path + ": must not be empty" + at);
 }
 
-void check_value(const PlannerList&, const std::vector<PlannerType>& v, const std::string& path,
-                 const std::string& at, Problems& out) {
+void check_value(const PlannerList&, const std::vector<PlannerType>& v, const std::string& path, const std::string& at,
+                 Problems& out) {
   if (v.empty()) out.push_back(path + ": must list at least one planner" + at);
   for (std::size_t i = 0; i < v.size(); ++i) {
     const std::string item = yaml_fields::indexed(path, i);

@@ -43,11 +43,11 @@ struct Range {
   bool hi_open{false};
 };
 inline Range any_number() { return {}; }
-inline Range at_least(double lo) { return {lo, std::nullopt, false, false}; }                 // >= lo
-inline Range above(double lo) { return {lo, std::nullopt, true, false}; }                     // > lo
-inline Range in(double lo, double hi) { return {lo, hi, false, false}; }                      // [lo, hi]
-inline Range in_open_closed(double lo, double hi) { return {lo, hi, true, false}; }           // (lo, hi]
-inline Range in_closed_open(double lo, double hi) { return {lo, hi, false, true}; }           // [lo, hi)
+inline Range at_least(double lo) { return {lo, std::nullopt, false, false}; }        // >= lo
+inline Range above(double lo) { return {lo, std::nullopt, true, false}; }            // > lo
+inline Range in(double lo, double hi) { return {lo, hi, false, false}; }             // [lo, hi]
+inline Range in_open_closed(double lo, double hi) { return {lo, hi, true, false}; }  // (lo, hi]
+inline Range in_closed_open(double lo, double hi) { return {lo, hi, false, true}; }  // [lo, hi)
 
 // A list of numbers: min_items..max_items entries, each in `each`.
 struct NumberList {
@@ -85,11 +85,10 @@ void check_value(const Range& r, int v, const std::string& path, const std::stri
 void check_value(const Range& r, std::size_t v, const std::string& path, const std::string& at, Problems& out);
 void check_value(const NumberList& l, const std::vector<double>& v, const std::string& path, const std::string& at,
                  Problems& out);
-void check_value(const Choices& c, const std::string& v, const std::string& path, const std::string& at,
-                 Problems& out);
+void check_value(const Choices& c, const std::string& v, const std::string& path, const std::string& at, Problems& out);
 void check_value(const NonEmpty&, const std::string& v, const std::string& path, const std::string& at, Problems& out);
-void check_value(const PlannerList&, const std::vector<PlannerType>& v, const std::string& path,
-                 const std::string& at, Problems& out);
+void check_value(const PlannerList&, const std::vector<PlannerType>& v, const std::string& path, const std::string& at,
+                 Problems& out);
 template <typename T>
 void check_value(const AnyValue&, const T&, const std::string&, const std::string&, Problems&) {}
 

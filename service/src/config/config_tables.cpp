@@ -34,8 +34,9 @@ const char* start_planner_hint(const std::string& key) {
 // Autoware freespace_planner keys this version does not implement (the A* is the only algorithm).
 const char* freespace_hint(const std::string& key) {
   static constexpr std::array<std::string_view, 6> kAutowareOnly{
-      "freespace_planner_algorithm", "rrtstar", "minimum_turning_radius", "maximum_turning_radius",
-      "turning_radius_size", "only_behind_solutions"};
+      "freespace_planner_algorithm", "rrtstar",
+      "minimum_turning_radius",      "maximum_turning_radius",
+      "turning_radius_size",         "only_behind_solutions"};
   return listed(key, kAutowareOnly.begin(), kAutowareOnly.end())
              ? "Autoware parameter not supported in this version (hybrid A* only)"
              : nullptr;
@@ -83,44 +84,43 @@ const Table<EgoPredictedPathParameters>& ego_predicted_path_table() {
 
 const Table<TargetFilteringParameters>& object_lane_configuration_table() {
   using T = TargetFilteringParameters;
-  static const Table<T> t{{
-                              field("check_current_lane", &T::check_current_lane, "", AnyValue{},
-                                    "objects on the road lanes the path merges into"),
-                              field("check_shoulder_lane", &T::check_shoulder_lane, "", AnyValue{},
-                                    "objects on road shoulders"),
-                          },
-                          &safety_hint};
+  static const Table<T> t{
+      {
+          field("check_current_lane", &T::check_current_lane, "", AnyValue{},
+                "objects on the road lanes the path merges into"),
+          field("check_shoulder_lane", &T::check_shoulder_lane, "", AnyValue{}, "objects on road shoulders"),
+      },
+      &safety_hint};
   return t;
 }
 
 const Table<TargetFilteringParameters>& target_filtering_table() {
   using T = TargetFilteringParameters;
-  static const Table<T> t{
-      {
-          field("safety_check_time_horizon", &T::safety_check_time_horizon, "s", in(0.0, 60.0),
-                "predicted paths are cut here"),
-          field("safety_check_time_resolution", &T::safety_check_time_resolution, "s", in(0.01, 10.0),
-                "predicted paths are resampled at this step"),
-          field("object_check_forward_distance", &T::object_check_forward_distance, "m", in(0.0, 1000.0),
-                "ahead of the ego, along the lane"),
-          field("object_check_backward_distance", &T::object_check_backward_distance, "m", in(0.0, 1000.0),
-                "behind the ego, along the lane"),
-          field("ignore_object_velocity_threshold", &T::ignore_object_velocity_threshold, "m/s", at_least(0.0),
-                "slower objects are not safety targets"),
-          group("object_types_to_check", &T::object_types_to_check, &object_types_table, ""),
-          group("object_lane_configuration", &object_lane_configuration_table, ""),
-          field("use_all_predicted_path", &T::use_all_predicted_path, "", AnyValue{},
-                "false: only the most confident predicted path"),
-          // Autoware's older name of use_all_predicted_path: both must allow all paths.
-          reader<T>("check_all_predicted_path",
-                    [](MapReader& r, T& p) {
-                      bool check_all = true;
-                      if (r.read("check_all_predicted_path", check_all)) {
-                        p.use_all_predicted_path = p.use_all_predicted_path && check_all;
-                      }
-                    }),
-      },
-      &safety_hint};
+  static const Table<T> t{{
+                              field("safety_check_time_horizon", &T::safety_check_time_horizon, "s", in(0.0, 60.0),
+                                    "predicted paths are cut here"),
+                              field("safety_check_time_resolution", &T::safety_check_time_resolution, "s",
+                                    in(0.01, 10.0), "predicted paths are resampled at this step"),
+                              field("object_check_forward_distance", &T::object_check_forward_distance, "m",
+                                    in(0.0, 1000.0), "ahead of the ego, along the lane"),
+                              field("object_check_backward_distance", &T::object_check_backward_distance, "m",
+                                    in(0.0, 1000.0), "behind the ego, along the lane"),
+                              field("ignore_object_velocity_threshold", &T::ignore_object_velocity_threshold, "m/s",
+                                    at_least(0.0), "slower objects are not safety targets"),
+                              group("object_types_to_check", &T::object_types_to_check, &object_types_table, ""),
+                              group("object_lane_configuration", &object_lane_configuration_table, ""),
+                              field("use_all_predicted_path", &T::use_all_predicted_path, "", AnyValue{},
+                                    "false: only the most confident predicted path"),
+                              // Autoware's older name of use_all_predicted_path: both must allow all paths.
+                              reader<T>("check_all_predicted_path",
+                                        [](MapReader& r, T& p) {
+                                          bool check_all = true;
+                                          if (r.read("check_all_predicted_path", check_all)) {
+                                            p.use_all_predicted_path = p.use_all_predicted_path && check_all;
+                                          }
+                                        }),
+                          },
+                          &safety_hint};
   return t;
 }
 
@@ -148,8 +148,8 @@ const Table<SafetyCheckParams>& safety_check_params_table() {
             "margins grow by this factor once unsafe"),
       field("collision_check_yaw_diff_threshold", &T::collision_check_yaw_diff_threshold, "rad", in(0.0, 3.15),
             "objects heading further apart are skipped"),
-      ignored<T, bool>("publish_debug_marker"),     // no markers here
-      ignored<T, double>("backward_path_length"),   // loaded but unused by Autoware too
+      ignored<T, bool>("publish_debug_marker"),    // no markers here
+      ignored<T, double>("backward_path_length"),  // loaded but unused by Autoware too
       ignored<T, double>("forward_path_length"),
       group("rss_params", &T::rss_params, &rss_table, ""),
   }};
@@ -212,44 +212,43 @@ const Table<FreespaceParameters::CostmapConfigs>& costmap_configs_table() {
 
 const Table<FreespaceParameters::Astar>& astar_table() {
   using T = FreespaceParameters::Astar;
-  static const Table<T> t{{
-                              field("use_back", &T::use_back, "", AnyValue{}, "reverse motion primitives"),
-                              field("distance_heuristic_weight", &T::distance_heuristic_weight, "", in(0.1, 10.0),
-                                    "> 1 is faster, less optimal"),
-                              field("expansion_distance", &T::expansion_distance, "m", in(0.05, 10.0),
-                                    "arc length of a motion primitive"),
-                              field("narrow_heuristic_penalty", &T::narrow_heuristic_penalty, "", in(0.0, 100.0),
-                                    "(not Autoware) heuristic cost x (1 + this) where too narrow to turn; 0 = off"),
-                          },
-                          &freespace_hint};
+  static const Table<T> t{
+      {
+          field("use_back", &T::use_back, "", AnyValue{}, "reverse motion primitives"),
+          field("distance_heuristic_weight", &T::distance_heuristic_weight, "", in(0.1, 10.0),
+                "> 1 is faster, less optimal"),
+          field("expansion_distance", &T::expansion_distance, "m", in(0.05, 10.0), "arc length of a motion primitive"),
+          field("narrow_heuristic_penalty", &T::narrow_heuristic_penalty, "", in(0.0, 100.0),
+                "(not Autoware) heuristic cost x (1 + this) where too narrow to turn; 0 = off"),
+      },
+      &freespace_hint};
   return t;
 }
 
 const Table<FreespaceParameters>& freespace_table() {
   using T = FreespaceParameters;
-  static const Table<T> t{
-      {
-          field("enable_freespace_planner", &T::enable_freespace_planner, "", AnyValue{},
-                "fallback when the lane-based search finds nothing"),
-          field("end_pose_search_start_distance", &T::end_pose_search_start_distance, "m", in(0.0, 500.0),
-                "end poses on the road centerline from s(ego) + this"),
-          field("end_pose_search_end_distance", &T::end_pose_search_end_distance, "m", in(0.0, 500.0),
-                "... to s(ego) + this, >= the start distance"),
-          field("end_pose_search_interval", &T::end_pose_search_interval, "m", in(0.1, 100.0),
-                "spacing of the end poses"),
-          field("velocity", &T::velocity, "m/s", in(0.01, 20.0), "speed on the freespace path"),
-          field("vehicle_shape_margin", &T::vehicle_shape_margin, "m", in(0.0, 5.0),
-                "added to the vehicle length and width"),
-          field("time_limit", &T::time_limit, "ms", in(1.0, 60000.0),
-                "search budget; the request deadline may cut it shorter"),
-          field("max_turning_ratio", &T::max_turning_ratio, "", in(0.05, 1.0),
-                "x vehicle.max_steer_angle for the motion primitives"),
-          field("turning_steps", &T::turning_steps, "", in(1, 10), "steering angles per side"),
-          group("search_configs", &T::search_configs, &search_configs_table, ""),
-          group("costmap_configs", &T::costmap_configs, &costmap_configs_table, ""),
-          group("astar", &T::astar, &astar_table, ""),
-      },
-      &freespace_hint};
+  static const Table<T> t{{
+                              field("enable_freespace_planner", &T::enable_freespace_planner, "", AnyValue{},
+                                    "fallback when the lane-based search finds nothing"),
+                              field("end_pose_search_start_distance", &T::end_pose_search_start_distance, "m",
+                                    in(0.0, 500.0), "end poses on the road centerline from s(ego) + this"),
+                              field("end_pose_search_end_distance", &T::end_pose_search_end_distance, "m",
+                                    in(0.0, 500.0), "... to s(ego) + this, >= the start distance"),
+                              field("end_pose_search_interval", &T::end_pose_search_interval, "m", in(0.1, 100.0),
+                                    "spacing of the end poses"),
+                              field("velocity", &T::velocity, "m/s", in(0.01, 20.0), "speed on the freespace path"),
+                              field("vehicle_shape_margin", &T::vehicle_shape_margin, "m", in(0.0, 5.0),
+                                    "added to the vehicle length and width"),
+                              field("time_limit", &T::time_limit, "ms", in(1.0, 60000.0),
+                                    "search budget; the request deadline may cut it shorter"),
+                              field("max_turning_ratio", &T::max_turning_ratio, "", in(0.05, 1.0),
+                                    "x vehicle.max_steer_angle for the motion primitives"),
+                              field("turning_steps", &T::turning_steps, "", in(1, 10), "steering angles per side"),
+                              group("search_configs", &T::search_configs, &search_configs_table, ""),
+                              group("costmap_configs", &T::costmap_configs, &costmap_configs_table, ""),
+                              group("astar", &T::astar, &astar_table, ""),
+                          },
+                          &freespace_hint};
   return t;
 }
 
@@ -323,8 +322,7 @@ const Table<StartPlannerParameters>& start_planner_table() {
           field("maximum_longitudinal_acc", &P::maximum_longitudinal_acc, "m/s^2", above(0.0),
                 "cap of the pull-out acceleration"),
 
-          note<P>("--- backward start-pose search: reverse first when no path starts at the current pose ---",
-                  true),
+          note<P>("--- backward start-pose search: reverse first when no path starts at the current pose ---", true),
           field("enable_back", &P::enable_back, "", AnyValue{}, ""),
           field("max_back_distance", &P::max_back_distance, "m", in(0.0, 200.0), ""),
           // With max_back_distance this bounds the start candidates to at most 2001.
@@ -411,8 +409,7 @@ const Table<ServiceConfig>& service_table() {
       field("worker_threads", &T::worker_threads, "", in(1, 64), "planning threads"),
       field("default_deadline_ms", &T::default_deadline_ms, "ms", above(0.0),
             "planning budget when a request gives none, <= limits.max_deadline_ms"),
-      field("log_level", &T::log_level, "", Choices{{kLogLevels.begin(), kLogLevels.end()}},
-            ""),
+      field("log_level", &T::log_level, "", Choices{{kLogLevels.begin(), kLogLevels.end()}}, ""),
       note<T>("Size limits of one request; a larger request is rejected with the field named."),
       group("limits", &T::limits, &limits_table, ""),
   }};

@@ -27,9 +27,11 @@ class Node;
 
 namespace pullout {
 
+// Units, allowed values and comments of these structs' members are in the config tables.
 struct DdsConfig {
-  int domain_id{0};                               // 0..232
-  std::string profiles_file{"dds/loopback.xml"};  // Fast DDS XML profiles; relative to the config file
+  int domain_id{0};
+  // load_config resolves it relative to the config file and checks that it exists.
+  std::string profiles_file{"dds/loopback.xml"};
   std::string participant_profile{"pullout_participant"};
 };
 
@@ -37,8 +39,8 @@ struct DdsConfig {
 inline constexpr std::array<const char*, 7> kLogLevels{"trace", "debug", "info", "warn", "error", "critical", "off"};
 
 struct ServiceConfig {
-  int worker_threads{2};              // planning threads, >= 1
-  double default_deadline_ms{200.0};  // planning budget when a request gives none
+  int worker_threads{2};
+  double default_deadline_ms{200.0};  // [ms]
   RequestLimits limits;
   std::string log_level{"info"};  // one of kLogLevels
 };
