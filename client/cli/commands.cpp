@@ -103,14 +103,7 @@ int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
     err << "pullout: " << e.what() << '\n';
     return kExitBadInput;
   }
-  std::vector<ParameterIssue> issues = validate_vehicle(scenario.vehicle);
-  for (auto& issue : validate_parameters(scenario.parameters)) issues.push_back(std::move(issue));
-  if (!issues.empty()) {
-    for (const auto& issue : issues) {
-      err << "pullout: " << options.scenario_file << ": " << issue.name << ": " << issue.problem << '\n';
-    }
-    return kExitBadInput;
-  }
+  // load_config and load_scenario have checked every parameter (ConfigError above).
 
   const StartPlanner planner(scenario.vehicle, scenario.parameters, config.service.limits, scenario.map);
   // The service's budget rule: the request's deadline, else the configured default.

@@ -1,6 +1,7 @@
 // pullout_service: the start planner as a Fast DDS microservice.
 //
 //   pullout_service --config config/pullout.yaml [--domain N] [--log-level L]
+//   pullout_service --print-config     # the documented config with every default (config/pullout.yaml)
 //
 // Exit codes: 0 after SIGINT/SIGTERM, 1 bad command line, config or map, 2 DDS setup failed, 3 any
 // other start-up failure. Everything is built inside one try block; a failure prints one line per
@@ -13,6 +14,7 @@
 #include <exception>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -66,14 +68,25 @@ int run(int argc, char** argv) {
   std::string config_path;
   int domain_id = -1;
   std::string log_level;
-  app.add_option("-c,--config", config_path, "config file (e.g. config/pullout.yaml)")->required();
+  bool print_config = false;
+  app.add_option("-c,--config", config_path, "config file (e.g. config/pullout.yaml)");
+  app.add_flag("--print-config", print_config,
+               "print the documented config file with every default (config/pullout.yaml) and exit");
   app.add_option("--domain", domain_id, "DDS domain id, overrides dds.domain_id")->check(CLI::Range(0, 232));
   app.add_option("--log-level", log_level, "overrides service.log_level")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+      ->check(CLI::IsMember(std::vector<std::string>(pullout::kLogLevels.begin(), pullout::kLogLevels.end())));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : kExitUsage;
+  }
+  if (print_config) {
+    std::fputs(pullout::documented_config().c_str(), stdout);
+    return 0;
+  }
+  if (config_path.empty()) {
+    std::fprintf(stderr, "pullout_service: --config is required\nRun with --help for more information.\n");
+    return kExitUsage;
   }
 
   const sigset_t stop_signals = block_stop_signals();

@@ -5,11 +5,14 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "pullout/model/names.hpp"
 
@@ -63,7 +66,7 @@ bool any_starts_with(const std::vector<std::string>& lines, const std::string& p
 
 // The first planner this version of the core does not implement, if any.
 std::optional<PlannerType> unavailable_planner() {
-  for (const PlannerType p : {PlannerType::kGeometric, PlannerType::kClothoid, PlannerType::kFreespace}) {
+  for (const PlannerType p : kSearchPlanners) {
     if (!planner_available(p)) return p;
   }
   return std::nullopt;
@@ -75,209 +78,131 @@ std::string dump(const std::vector<std::string>& lines) {
   return s;
 }
 
-TEST(Config, ShippedConfigLoadsWithTheStructDefaults) {
-  const Config c = load_config(kShippedConfig);
-  const Config d;
-  EXPECT_DOUBLE_EQ(c.vehicle.wheel_base_m, d.vehicle.wheel_base_m);
-  EXPECT_DOUBLE_EQ(c.vehicle.wheel_tread_m, d.vehicle.wheel_tread_m);
-  EXPECT_DOUBLE_EQ(c.vehicle.front_overhang_m, d.vehicle.front_overhang_m);
-  EXPECT_DOUBLE_EQ(c.vehicle.rear_overhang_m, d.vehicle.rear_overhang_m);
-  EXPECT_DOUBLE_EQ(c.vehicle.left_overhang_m, d.vehicle.left_overhang_m);
-  EXPECT_DOUBLE_EQ(c.vehicle.right_overhang_m, d.vehicle.right_overhang_m);
-  EXPECT_DOUBLE_EQ(c.vehicle.max_steer_angle_rad, d.vehicle.max_steer_angle_rad);
-
-  const StartPlannerParameters& p = c.start_planner;
-  const StartPlannerParameters& q = d.start_planner;
-  EXPECT_DOUBLE_EQ(p.th_arrived_distance, q.th_arrived_distance);
-  EXPECT_DOUBLE_EQ(p.th_stopped_velocity, q.th_stopped_velocity);
-  EXPECT_DOUBLE_EQ(p.th_stopped_time, q.th_stopped_time);
-  EXPECT_EQ(p.collision_check_margins, q.collision_check_margins);
-  EXPECT_EQ(p.search_priority, q.search_priority);
-  EXPECT_EQ(p.search_policy, q.search_policy);
-  EXPECT_DOUBLE_EQ(p.th_moving_object_velocity, q.th_moving_object_velocity);
-  EXPECT_EQ(p.object_types_to_check_for_path_generation.check_unknown,
-            q.object_types_to_check_for_path_generation.check_unknown);
-  EXPECT_DOUBLE_EQ(p.center_line_path_interval, q.center_line_path_interval);
-  EXPECT_DOUBLE_EQ(p.forward_path_length, q.forward_path_length);
-  EXPECT_EQ(p.check_shift_path_lane_departure, q.check_shift_path_lane_departure);
-  EXPECT_EQ(p.allow_check_shift_path_lane_departure_override, q.allow_check_shift_path_lane_departure_override);
-  EXPECT_DOUBLE_EQ(p.lane_departure_check_expansion_margin, q.lane_departure_check_expansion_margin);
-  EXPECT_DOUBLE_EQ(p.shift_collision_check_distance_from_end, q.shift_collision_check_distance_from_end);
-  EXPECT_DOUBLE_EQ(p.minimum_shift_pull_out_distance, q.minimum_shift_pull_out_distance);
-  EXPECT_DOUBLE_EQ(p.lateral_jerk, q.lateral_jerk);
-  EXPECT_EQ(p.lateral_acceleration_sampling_num, q.lateral_acceleration_sampling_num);
-  EXPECT_DOUBLE_EQ(p.minimum_lateral_acc, q.minimum_lateral_acc);
-  EXPECT_DOUBLE_EQ(p.maximum_lateral_acc, q.maximum_lateral_acc);
-  EXPECT_DOUBLE_EQ(p.maximum_curvature, q.maximum_curvature);
-  EXPECT_DOUBLE_EQ(p.end_pose_curvature_threshold, q.end_pose_curvature_threshold);
-  EXPECT_DOUBLE_EQ(p.maximum_longitudinal_acc, q.maximum_longitudinal_acc);
-  EXPECT_EQ(p.enable_back, q.enable_back);
-  EXPECT_DOUBLE_EQ(p.max_back_distance, q.max_back_distance);
-  EXPECT_DOUBLE_EQ(p.backward_search_resolution, q.backward_search_resolution);
-  EXPECT_DOUBLE_EQ(p.collision_check_margin_from_front_object, q.collision_check_margin_from_front_object);
-  EXPECT_DOUBLE_EQ(p.ignore_distance_from_lane_end, q.ignore_distance_from_lane_end);
-  EXPECT_DOUBLE_EQ(p.backward_velocity, q.backward_velocity);
-  EXPECT_DOUBLE_EQ(p.geometric_pull_out_velocity, q.geometric_pull_out_velocity);
-  EXPECT_DOUBLE_EQ(p.arc_path_interval, q.arc_path_interval);
-  EXPECT_DOUBLE_EQ(p.lane_departure_margin, q.lane_departure_margin);
-  EXPECT_DOUBLE_EQ(p.geometric_pull_out_max_steer_angle_margin_scale,
-                   q.geometric_pull_out_max_steer_angle_margin_scale);
-  EXPECT_EQ(p.divide_pull_out_path, q.divide_pull_out_path);
-  EXPECT_DOUBLE_EQ(p.geometric_collision_check_distance_from_end, q.geometric_collision_check_distance_from_end);
-  EXPECT_DOUBLE_EQ(p.clothoid_initial_velocity, q.clothoid_initial_velocity);
-  EXPECT_DOUBLE_EQ(p.clothoid_acceleration, q.clothoid_acceleration);
-  EXPECT_EQ(p.clothoid_max_steer_angles_deg, q.clothoid_max_steer_angles_deg);
-  EXPECT_DOUBLE_EQ(p.clothoid_max_steer_angle_rate_deg_per_sec, q.clothoid_max_steer_angle_rate_deg_per_sec);
-  EXPECT_DOUBLE_EQ(p.clothoid_collision_check_distance_from_end, q.clothoid_collision_check_distance_from_end);
-  EXPECT_EQ(p.check_clothoid_path_lane_departure, q.check_clothoid_path_lane_departure);
-  const FreespaceParameters& f = p.freespace_planner;
-  const FreespaceParameters& g = q.freespace_planner;
-  EXPECT_EQ(f.enable_freespace_planner, g.enable_freespace_planner);
-  EXPECT_DOUBLE_EQ(f.end_pose_search_start_distance, g.end_pose_search_start_distance);
-  EXPECT_DOUBLE_EQ(f.end_pose_search_end_distance, g.end_pose_search_end_distance);
-  EXPECT_DOUBLE_EQ(f.end_pose_search_interval, g.end_pose_search_interval);
-  EXPECT_DOUBLE_EQ(f.velocity, g.velocity);
-  EXPECT_DOUBLE_EQ(f.vehicle_shape_margin, g.vehicle_shape_margin);
-  EXPECT_DOUBLE_EQ(f.time_limit, g.time_limit);
-  EXPECT_DOUBLE_EQ(f.max_turning_ratio, g.max_turning_ratio);
-  EXPECT_EQ(f.turning_steps, g.turning_steps);
-  EXPECT_EQ(f.search_configs.theta_size, g.search_configs.theta_size);
-  EXPECT_DOUBLE_EQ(f.search_configs.angle_goal_range, g.search_configs.angle_goal_range);
-  EXPECT_DOUBLE_EQ(f.search_configs.lateral_goal_range, g.search_configs.lateral_goal_range);
-  EXPECT_DOUBLE_EQ(f.search_configs.longitudinal_goal_range, g.search_configs.longitudinal_goal_range);
-  EXPECT_DOUBLE_EQ(f.search_configs.curve_weight, g.search_configs.curve_weight);
-  EXPECT_DOUBLE_EQ(f.search_configs.reverse_weight, g.search_configs.reverse_weight);
-  EXPECT_DOUBLE_EQ(f.search_configs.direction_change_weight, g.search_configs.direction_change_weight);
-  EXPECT_EQ(f.costmap_configs.obstacle_threshold, g.costmap_configs.obstacle_threshold);
-  EXPECT_DOUBLE_EQ(f.costmap_configs.resolution, g.costmap_configs.resolution);
-  EXPECT_EQ(f.astar.use_back, g.astar.use_back);
-  EXPECT_DOUBLE_EQ(f.astar.distance_heuristic_weight, g.astar.distance_heuristic_weight);
-  EXPECT_DOUBLE_EQ(f.astar.expansion_distance, g.astar.expansion_distance);
-  EXPECT_DOUBLE_EQ(f.astar.narrow_heuristic_penalty, g.astar.narrow_heuristic_penalty);
-
-  EXPECT_EQ(c.service.worker_threads, d.service.worker_threads);
-  EXPECT_DOUBLE_EQ(c.service.default_deadline_ms, d.service.default_deadline_ms);
-  EXPECT_EQ(c.service.log_level, d.service.log_level);
-  EXPECT_EQ(c.service.limits.max_lanes, d.service.limits.max_lanes);
-  EXPECT_EQ(c.service.limits.max_points_per_line, d.service.limits.max_points_per_line);
-  EXPECT_EQ(c.service.limits.max_objects, d.service.limits.max_objects);
-  EXPECT_EQ(c.service.limits.max_polygon_points, d.service.limits.max_polygon_points);
-  EXPECT_EQ(c.service.limits.max_predicted_paths, d.service.limits.max_predicted_paths);
-  EXPECT_EQ(c.service.limits.max_predicted_path_points, d.service.limits.max_predicted_path_points);
-  EXPECT_EQ(c.service.limits.max_route_lanelets, d.service.limits.max_route_lanelets);
-  EXPECT_EQ(c.service.limits.max_grid_cells, d.service.limits.max_grid_cells);
-  EXPECT_DOUBLE_EQ(c.service.limits.max_deadline_ms, d.service.limits.max_deadline_ms);
-
-  EXPECT_EQ(c.dds.domain_id, d.dds.domain_id);
-  EXPECT_EQ(c.dds.participant_profile, d.dds.participant_profile);
-  // Resolved relative to the config file.
-  EXPECT_EQ(std::filesystem::path(c.dds.profiles_file),
-            std::filesystem::path(kSourceDir + "/config/dds/loopback.xml").lexically_normal());
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-TEST(Config, ShippedConfigSetsEveryKey) {
-  // Every key the loader knows appears in the shipped file: removing any one of them must still
-  // load (keys are optional), and the file mentions each by name.
-  std::ifstream in(kShippedConfig);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (const char* key : {"wheel_base",
-                          "wheel_tread",
-                          "front_overhang",
-                          "rear_overhang",
-                          "left_overhang",
-                          "right_overhang",
-                          "max_steer_angle",
-                          "th_arrived_distance",
-                          "th_stopped_velocity",
-                          "th_stopped_time",
-                          "collision_check_margins",
-                          "search_priority",
-                          "search_policy",
-                          "th_moving_object_velocity",
-                          "object_types_to_check_for_path_generation",
-                          "check_car",
-                          "check_truck",
-                          "check_bus",
-                          "check_trailer",
-                          "check_bicycle",
-                          "check_motorcycle",
-                          "check_pedestrian",
-                          "check_unknown",
-                          "center_line_path_interval",
-                          "forward_path_length",
-                          "check_shift_path_lane_departure",
-                          "allow_check_shift_path_lane_departure_override",
-                          "lane_departure_check_expansion_margin",
-                          "shift_collision_check_distance_from_end",
-                          "minimum_shift_pull_out_distance",
-                          "lateral_jerk",
-                          "lateral_acceleration_sampling_num",
-                          "minimum_lateral_acc",
-                          "maximum_lateral_acc",
-                          "maximum_curvature",
-                          "end_pose_curvature_threshold",
-                          "maximum_longitudinal_acc",
-                          "enable_back",
-                          "max_back_distance",
-                          "backward_search_resolution",
-                          "collision_check_margin_from_front_object",
-                          "ignore_distance_from_lane_end",
-                          "backward_velocity",
-                          "geometric_pull_out_velocity",
-                          "arc_path_interval",
-                          "lane_departure_margin",
-                          "geometric_pull_out_max_steer_angle_margin_scale",
-                          "divide_pull_out_path",
-                          "geometric_collision_check_distance_from_end",
-                          "clothoid_initial_velocity",
-                          "clothoid_acceleration",
-                          "clothoid_max_steer_angles_deg",
-                          "clothoid_max_steer_angle_rate_deg_per_sec",
-                          "clothoid_collision_check_distance_from_end",
-                          "check_clothoid_path_lane_departure",
-                          "freespace_planner",
-                          "enable_freespace_planner",
-                          "end_pose_search_start_distance",
-                          "end_pose_search_end_distance",
-                          "end_pose_search_interval",
-                          "velocity",
-                          "vehicle_shape_margin",
-                          "time_limit",
-                          "max_turning_ratio",
-                          "turning_steps",
-                          "search_configs",
-                          "theta_size",
-                          "angle_goal_range",
-                          "lateral_goal_range",
-                          "longitudinal_goal_range",
-                          "curve_weight",
-                          "reverse_weight",
-                          "direction_change_weight",
-                          "costmap_configs",
-                          "obstacle_threshold",
-                          "resolution",
-                          "astar",
-                          "use_back",
-                          "distance_heuristic_weight",
-                          "expansion_distance",
-                          "narrow_heuristic_penalty",
-                          "worker_threads",
-                          "default_deadline_ms",
-                          "log_level",
-                          "max_lanes",
-                          "max_points_per_line",
-                          "max_objects",
-                          "max_polygon_points",
-                          "max_predicted_paths",
-                          "max_predicted_path_points",
-                          "max_route_lanelets",
-                          "max_grid_cells",
-                          "max_deadline_ms",
-                          "domain_id",
-                          "profiles_file",
-                          "participant_profile"}) {
-    EXPECT_NE(text.find(std::string(key) + ":"), std::string::npos) << key;
+std::vector<std::string> split_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// The dotted paths of the leaves (scalars and lists) of a YAML mapping.
+void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& out) {
+  for (const auto& entry : node) {
+    const std::string path = prefix.empty() ? entry.first.Scalar() : prefix + "." + entry.first.Scalar();
+    if (entry.second.IsMap()) {
+      collect_leaves(entry.second, path, out);
+    } else {
+      out.push_back(path);
+    }
   }
+}
+
+TEST(ConfigTable, ShippedFileIsTheDocumentedConfig) {
+  // config/pullout.yaml is generated from the tables: same keys, same order, same defaults, units,
+  // allowed values and comments. A key added to a table (or a struct default changed) without
+  // regenerating the file fails here, and so does a key added to the file only.
+  const std::vector<std::string> shipped = split_lines(read_text(kShippedConfig));
+  const std::vector<std::string> generated = split_lines(documented_config());
+  const std::size_t n = std::min(shipped.size(), generated.size());
+  std::size_t first = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (shipped[i] != generated[i]) {
+      first = i;
+      break;
+    }
+  }
+  if (first == n && shipped.size() == generated.size()) return;
+  ADD_FAILURE() << "config/pullout.yaml differs from the config tables at line " << first + 1
+                << ":\n  file:   " << (first < shipped.size() ? shipped[first] : "(end of file)")
+                << "\n  tables: " << (first < generated.size() ? generated[first] : "(end)")
+                << "\nRegenerate it: build/service/pullout_service --print-config > config/pullout.yaml";
+}
+
+TEST(ConfigTable, ShippedFileReadsBackToTheDefaults) {
+  // Every value written in the file reads back as the struct default it was written from (the
+  // documented text of what was read equals the documented text of the defaults).
+  Config loaded = load_config(kShippedConfig);
+  // Resolved relative to the config file.
+  EXPECT_EQ(std::filesystem::path(loaded.dds.profiles_file),
+            std::filesystem::path(kSourceDir + "/config/dds/loopback.xml").lexically_normal());
+  loaded.dds.profiles_file = Config{}.dds.profiles_file;
+  EXPECT_EQ(documented_config(loaded), documented_config());
+}
+
+TEST(ConfigTable, DocumentedValuesAreWhatWasRead) {
+  // The documented text shows the values of the config it is given, not constants.
+  ConfigFile file(std::string(kMinimal) +
+                  "start_planner:\n  lateral_jerk: 0.7\n  search_priority: [geometric]\n"
+                  "  path_safety_check: {target_filtering: {object_types_to_check: {check_bus: false}}}\n");
+  const std::string text = documented_config(load_config(file.path()));
+  EXPECT_NE(text.find("\n  lateral_jerk: 0.7 "), std::string::npos) << text;
+  EXPECT_NE(text.find("\n  search_priority: [GEOMETRIC] "), std::string::npos) << text;
+  EXPECT_NE(text.find("\n        check_bus: false"), std::string::npos) << text;
+  EXPECT_EQ(documented_config().find("lateral_jerk: 0.7 "), std::string::npos);
+}
+
+TEST(ConfigTable, EveryDocumentedKeyIsReadAndTypeChecked) {
+  // Each key of the documented file, given a mapping instead of its value, gives exactly one
+  // problem naming that key: every key the file documents is one the loader reads.
+  const std::string documented = documented_config();
+  std::vector<std::string> leaves;
+  collect_leaves(YAML::Load(documented), "", leaves);
+  ASSERT_GT(leaves.size(), 100u);
+  for (const std::string& leaf : leaves) {
+    YAML::Node root = YAML::Load(documented);
+    std::vector<YAML::Node> chain{root};  // copies share the nodes; no assignment between them
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t dot = leaf.find('.', start);
+      chain.push_back(chain.back()[leaf.substr(start, dot == std::string::npos ? std::string::npos : dot - start)]);
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+    chain.back() = YAML::Load("{not_a_value: 1}");
+    YAML::Emitter out;
+    out << root;
+    const auto p = problems_of(out.c_str());
+    ASSERT_EQ(p.size(), 1u) << leaf << "\n" << dump(p);
+    EXPECT_EQ(p[0].rfind(leaf + ": expected ", 0), 0u) << leaf << "\n" << dump(p);
+  }
+}
+
+TEST(ConfigTable, DefaultsAreAllowedValues) { EXPECT_TRUE(check_config(Config{}).empty()) << dump(check_config({})); }
+
+TEST(ConfigTable, CheckConfigNamesEveryBadMember) {
+  Config c;
+  c.vehicle.max_steer_angle_rad = 2.0;
+  c.start_planner.lateral_jerk = -1.0;
+  c.start_planner.collision_check_margins = {1.0, -0.5};
+  c.start_planner.path_safety_check.safety_check_params.rss_params.rear_vehicle_deceleration = 1.0;
+  c.start_planner.freespace_planner.search_configs.theta_size = 3;
+  c.start_planner.minimum_lateral_acc = 0.6;  // > maximum_lateral_acc: between keys
+  c.service.limits.max_objects = 0;
+  c.dds.participant_profile.clear();
+  const auto p = check_config(c);
+  EXPECT_TRUE(any_starts_with(p, "vehicle.max_steer_angle: must be in [0.01, 1.5], got 2")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.lateral_jerk: must be > 0, got -1")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.collision_check_margins[1]: must be in [0, 10], got -0.5")) << dump(p);
+  EXPECT_TRUE(any_starts_with(
+      p, "start_planner.path_safety_check.safety_check_params.rss_params.rear_vehicle_deceleration: must be in"))
+      << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.search_configs.theta_size: must be in [8, 720]"))
+      << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.maximum_lateral_acc: must be >= minimum_lateral_acc")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "service.limits.max_objects: must be >= 1, got 0")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "dds.participant_profile: must not be empty")) << dump(p);
+  EXPECT_EQ(p.size(), 8u) << dump(p);
+}
+
+TEST(ConfigTable, OutOfRangeValueInAFileCarriesItsLine) {
+  const auto p = problems_of(std::string(kMinimal) + "start_planner:\n  lateral_jerk: 0.4\n  max_back_distance: 500\n");
+  ASSERT_EQ(p.size(), 1u) << dump(p);
+  EXPECT_EQ(p[0], "start_planner.max_back_distance: must be in [0, 200], got 500 (line 4)");
 }
 
 TEST(Config, MinimalConfigLoads) { EXPECT_TRUE(problems_of(kMinimal).empty()) << dump(problems_of(kMinimal)); }
@@ -348,7 +273,7 @@ TEST(Config, OutOfRangeIsNamed) {
   EXPECT_TRUE(any_starts_with(p, "start_planner.maximum_lateral_acc: must be >= minimum_lateral_acc")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "service.worker_threads: must be in [1, 64]")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "service.default_deadline_ms: must be in")) << dump(p);
-  EXPECT_TRUE(any_starts_with(p, "service.log_level: unknown level 'loud'")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "service.log_level: unknown value 'loud' (expected trace, debug,")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "dds.domain_id: must be in [0, 232]")) << dump(p);
 }
 
@@ -366,8 +291,7 @@ TEST(Config, SeveralProblemsAreReportedTogether) {
   EXPECT_TRUE(any_starts_with(p, "start_planner.bogus: unknown key")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "start_planner.lateral_jerk: expected a number")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "service.worker_threads:")) << dump(p);
-  EXPECT_TRUE(any_starts_with(p, "dds.profiles_file: required")) << dump(p);
-  EXPECT_EQ(p.size(), 5u) << dump(p);
+  EXPECT_EQ(p.size(), 4u) << dump(p);
 }
 
 TEST(Config, SearchPriorityAcceptsAutowareAndModelNames) {
@@ -456,16 +380,25 @@ TEST(Config, SyntaxErrorAndUnreadableFile) {
   EXPECT_TRUE(any_starts_with(q, "document: expected a mapping")) << dump(q);
 }
 
-TEST(Config, EmptyFileUsesDefaultsButNeedsTheProfilesFile) {
-  const auto p = problems_of("");
-  ASSERT_EQ(p.size(), 1u) << dump(p);
-  EXPECT_TRUE(any_starts_with(p, "dds.profiles_file: required")) << dump(p);
+TEST(Config, EmptyFileUsesTheDefaults) {
+  // The default profiles file is dds/loopback.xml beside the config file.
+  ConfigFile file("");
+  const Config c = load_config(file.path());
+  EXPECT_EQ(c.dds.profiles_file, (file.dir() / "dds" / "loopback.xml").string());
+  EXPECT_EQ(documented_config(Config{}), [&] {
+    Config d = c;
+    d.dds.profiles_file = Config{}.dds.profiles_file;
+    return documented_config(d);
+  }());
 }
 
-TEST(Config, ValidatorsAcceptDefaults) {
-  EXPECT_TRUE(validate_parameters(StartPlannerParameters{}).empty());
-  EXPECT_TRUE(validate_vehicle(VehicleInfo{}).empty());
+TEST(Config, EmptyProfilesFileIsAnError) {
+  const auto p = problems_of("dds: {profiles_file: \"\"}\n");
+  ASSERT_EQ(p.size(), 1u) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "dds.profiles_file: must not be empty")) << dump(p);
 }
+
+TEST(Config, ValidatorsAcceptDefaults) { EXPECT_TRUE(validate_parameters(StartPlannerParameters{}).empty()); }
 
 TEST(Config, ObjectTypesToCheckIncludes) {
   ObjectTypesToCheck t;

@@ -68,8 +68,7 @@ std::vector<std::size_t> indices_of(const LaneWorld& world, const std::vector<st
 }
 
 const std::vector<PlannerType>& available_planners() {
-  static const std::vector<PlannerType> kAvailable{PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid,
-                                                   PlannerType::kFreespace};
+  static const std::vector<PlannerType> kAvailable(kSearchPlanners.begin(), kSearchPlanners.end());
   return kAvailable;
 }
 

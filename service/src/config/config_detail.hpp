@@ -16,9 +16,6 @@ namespace pullout {
 // model's lower case ("shift").
 std::optional<PlannerType> parse_planner_name(const std::string& name);
 
-// One of spdlog's level names: trace, debug, info, warn, error, critical, off.
-bool is_log_level(const std::string& level);
-
 std::string format_number(double v);
 
 // Reads and parses a YAML file. Throws ConfigError("cannot read file" or the parser's message with

@@ -245,7 +245,6 @@ Scenario load_scenario(const std::string& path, const Config& base) {
 
   if (root.has("vehicle")) {
     apply_vehicle_info(root.get("vehicle"), "vehicle", s.vehicle, problems);
-    append_parameter_issues(validate_vehicle(s.vehicle), "vehicle", problems);
   }
   std::string map_file;
   if (root.read("map", map_file)) {
@@ -295,7 +294,7 @@ Scenario load_scenario(const std::string& path, const Config& base) {
   if (root.has("planner")) {
     const YAML::Node planner = root.get("planner");
     apply_start_planner_parameters(planner, "planner", s.parameters, problems);
-    append_parameter_issues(validate_parameters(s.parameters), "planner", problems);
+    append_parameter_issues(validate_parameters(s.parameters), "planner", problems);  // between keys
     set_overrides(planner, s.parameters, request.overrides);
   }
   if (root.read("deadline_ms", request.deadline_ms) && request.deadline_ms < 0.0) {

@@ -80,14 +80,8 @@ inline const char* to_string(LaneSubtype v) { return detail::name_of(detail::kSu
 inline std::optional<PlannerType> planner_type_from_string(std::string_view n) {
   return detail::value_of(detail::kPlannerNames, n);
 }
-inline std::optional<ExecutionState> execution_state_from_string(std::string_view n) {
-  return detail::value_of(detail::kStateNames, n);
-}
 inline std::optional<ObjectClass> object_class_from_string(std::string_view n) {
   return detail::value_of(detail::kClassNames, n);
-}
-inline std::optional<TurnSignal> turn_signal_from_string(std::string_view n) {
-  return detail::value_of(detail::kTurnSignalNames, n);
 }
 inline std::optional<SearchPolicy> search_policy_from_string(std::string_view n) {
   return detail::value_of(detail::kPolicyNames, n);
@@ -95,5 +89,17 @@ inline std::optional<SearchPolicy> search_policy_from_string(std::string_view n)
 inline std::optional<LaneSubtype> lane_subtype_from_string(std::string_view n) {
   return detail::value_of(detail::kSubtypeNames, n);
 }
+
+// ---- The planners a search can run (search_priority, request overrides), in their usual order.
+// The one list of them: config reading, parameter and request validation and their messages use it.
+inline constexpr std::array<PlannerType, 4> kSearchPlanners{PlannerType::kShift, PlannerType::kGeometric,
+                                                            PlannerType::kClothoid, PlannerType::kFreespace};
+inline constexpr bool is_search_planner(PlannerType p) {
+  for (const PlannerType q : kSearchPlanners) {
+    if (q == p) return true;
+  }
+  return false;
+}
+// ---- end of the planner list
 
 }  // namespace pullout

@@ -1,6 +1,7 @@
 // Parameters of the start planner. Names follow Autoware's start_planner.param.yaml where the
-// concept is the same (see config/pullout.yaml), defaults are the same as that file's.
-// validate_parameters() reports every out-of-range value; the core assumes validated parameters.
+// concept is the same (see config/pullout.yaml), defaults are the same as that file's. The core
+// assumes valid parameters: each key's allowed values are checked by the config tables
+// (pullout::check_config, load_config), the checks between keys by validate_parameters().
 #pragma once
 
 #include <cstddef>
@@ -129,10 +130,9 @@ struct ParameterIssue {
   std::string problem;
 };
 
-// Every out-of-range or inconsistent value, in declaration order. Empty when valid.
+// The checks that involve more than one parameter (maximum >= minimum) and search_priority
+// entries this version does not implement; names are config key paths. Empty when valid.
 std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p);
-// Same for the vehicle (names are the VehicleInfo field names without the unit suffix).
-std::vector<ParameterIssue> validate_vehicle(const VehicleInfo& v);
 
 // Limits on the size of a request, so that one vehicle cannot make the service allocate or compute
 // without bound. Defaults are generous for real use.

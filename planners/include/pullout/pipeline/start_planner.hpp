@@ -64,8 +64,8 @@ struct PlanningResult {
 
 class StartPlanner {
  public:
-  // Parameters must be valid (validate_parameters / validate_vehicle return nothing). `map` may be
-  // null (no map: only inline lanes are accepted).
+  // Parameters must be valid (as load_config / check_config accept them). `map` may be null (no
+  // map: only inline lanes are accepted).
   StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits = {},
                std::shared_ptr<const LaneletMap> map = nullptr);
 

@@ -1,6 +1,6 @@
 // Parameters of the dynamic-object safety checks before and after departure. Names and defaults
 // follow Autoware's start_planner.param.yaml (path_safety_check.*, surround_moving_obstacle_check.*,
-// stop_condition.*); see config/pullout.yaml. Validated by validate_parameters().
+// stop_condition.*); see config/pullout.yaml. Range-checked by the config tables.
 #pragma once
 
 #include <string>

@@ -3,11 +3,17 @@
 // The file has five sections: `vehicle` (VehicleInfo fields without the unit suffix, e.g.
 // wheel_base), `start_planner` (StartPlannerParameters, Autoware's names), `service` (workers,
 // default deadline, request limits, log level), `dds` (domain id, XML profiles file, participant
-// profile) and `map` (the Lanelet2 map file; its content is loaded by the service, not here). Every key is optional
-// (the struct defaults apply) but an unknown key, a value of the wrong type or an out-of-range value is an error.
-// load_config() reports every problem at once.
+// profile) and `map` (the Lanelet2 map file; its content is loaded by the service, not here). Every
+// key is optional (the struct defaults apply) but an unknown key, a value of the wrong type or an
+// out-of-range value is an error. load_config() reports every problem at once.
+//
+// Each key is written once, in the config tables (service/src/config/config_tables.cpp: name,
+// member, unit, allowed values, comment; the default is the member's initialiser). They drive the
+// reading, the range checks and the documented file: config/pullout.yaml is documented_config()
+// (`pullout_service --print-config`), and a test checks that the two agree.
 #pragma once
 
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,17 +27,22 @@ class Node;
 
 namespace pullout {
 
+// Units, allowed values and comments of these structs' members are in the config tables.
 struct DdsConfig {
-  int domain_id{0};           // 0..232
-  std::string profiles_file;  // Fast DDS XML profiles; relative paths are relative to the config file
+  int domain_id{0};
+  // load_config resolves it relative to the config file and checks that it exists.
+  std::string profiles_file{"dds/loopback.xml"};
   std::string participant_profile{"pullout_participant"};
 };
 
+// spdlog's level names: the values of service.log_level and pullout_service --log-level.
+inline constexpr std::array<const char*, 7> kLogLevels{"trace", "debug", "info", "warn", "error", "critical", "off"};
+
 struct ServiceConfig {
-  int worker_threads{2};              // planning threads, >= 1
-  double default_deadline_ms{200.0};  // planning budget when a request gives none
+  int worker_threads{2};
+  double default_deadline_ms{200.0};  // [ms]
   RequestLimits limits;
-  std::string log_level{"info"};  // trace, debug, info, warn, error, critical, off
+  std::string log_level{"info"};  // one of kLogLevels
 };
 
 struct MapConfig {
@@ -69,5 +80,14 @@ void apply_start_planner_parameters(const YAML::Node& node, const std::string& p
                                     std::vector<std::string>& problems);
 void apply_vehicle_info(const YAML::Node& node, const std::string& prefix, VehicleInfo& vehicle,
                         std::vector<std::string>& problems);
+
+// Every value of `config` outside its allowed values and every inconsistency between keys, one
+// "<key path>: <problem>" line each; empty when valid. What load_config checks after reading,
+// except that files (dds.profiles_file, map.path) are not looked for. For configs built in code.
+std::vector<std::string> check_config(const Config& config);
+
+// The documented config file for `values`: every key with its value, unit, allowed values and
+// comment, in the file's order. documented_config(Config{}) is config/pullout.yaml.
+std::string documented_config(const Config& values = Config{});
 
 }  // namespace pullout
