@@ -51,7 +51,9 @@ void BM_Plan_FreespaceBoxedIn(benchmark::State& state) { plan_scenario(state, "f
 void BM_Plan_FreespacePerpendicularBay(benchmark::State& state) { plan_scenario(state, "freespace_perpendicular_bay"); }
 // How promptly a search stops at its deadline: 1 ms for the freespace bay (costmap set-up plus the
 // search's check interval on top of it; the unit test only checks that it times out).
-void BM_Plan_FreespaceTinyDeadline(benchmark::State& state) { plan_scenario(state, "freespace_perpendicular_bay", 1.0); }
+void BM_Plan_FreespaceTinyDeadline(benchmark::State& state) {
+  plan_scenario(state, "freespace_perpendicular_bay", 1.0);
+}
 // A pure freespace problem: a grid and a goal pose, no lanes.
 void BM_Plan_FreespaceParkingLot(benchmark::State& state) { plan_scenario(state, "freespace_parking_lot"); }
 

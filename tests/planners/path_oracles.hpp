@@ -29,7 +29,6 @@ inline double point_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
   return (a + t * d - p).norm();
 }
 
-
 // ---- separating-axis test (convex polygons) ----
 
 inline bool is_convex(const Polygon& p) {

@@ -221,8 +221,8 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
   // Between the points too, every 5 cm: the body never touches an object (the whole path).
   for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
     for (const Pose2& pose : poses_along(path.partial_paths[k], 0.05)) {
-      ASSERT_GT(clearance_at(pose), 0.0) << "contact between the points of segment " << k << " at (" << pose.x
-                                         << ", " << pose.y << ")";
+      ASSERT_GT(clearance_at(pose), 0.0) << "contact between the points of segment " << k << " at (" << pose.x << ", "
+                                         << pose.y << ")";
       if (grid != nullptr) {
         ASSERT_FALSE(overlaps_grid(*grid, threshold, rectangle_at(body, pose)))
             << "occupied cell between the points of segment " << k << " at (" << pose.x << ", " << pose.y << ")";
@@ -232,9 +232,9 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
 
   // Curvature within the vehicle's limit (freespace: its own max_turning_ratio of the steering),
   // from three consecutive points; 2 % covers the chords of the sampled arcs.
-  const double k_max = freespace ? std::tan(sc.vehicle.max_steer_angle_rad * fp.max_turning_ratio) /
-                                       sc.vehicle.wheel_base_m
-                                 : 1.0 / sc.vehicle.min_turning_radius_m();
+  const double k_max = freespace
+                           ? std::tan(sc.vehicle.max_steer_angle_rad * fp.max_turning_ratio) / sc.vehicle.wheel_base_m
+                           : 1.0 / sc.vehicle.min_turning_radius_m();
   for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
     const auto& pts = path.partial_paths[k].points;
     for (std::size_t i = 1; i + 1 < pts.size(); ++i) {
@@ -295,8 +295,9 @@ TEST_P(ScenarioExpectations, MatchTheFile) {
 
 // The map scenarios too (their path properties are checked in test_map_planning.cpp).
 const char* const kExpectationScenarios[] = {
-    "straight_shoulder", "curved_road",           "parked_car_ahead", "boxed_in",    "parallel_spot",
-    "perpendicular_bay", "parallel_spot_reverse", "car_close_ahead",  "full_search", "map_shoulder", "clothoid_only"};
+    "straight_shoulder", "curved_road",       "parked_car_ahead",      "boxed_in",
+    "parallel_spot",     "perpendicular_bay", "parallel_spot_reverse", "car_close_ahead",
+    "full_search",       "map_shoulder",      "clothoid_only"};
 INSTANTIATE_TEST_SUITE_P(Bundled, ScenarioExpectations, ::testing::ValuesIn(kExpectationScenarios));
 
 TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {
