@@ -271,6 +271,57 @@ TEST(PlannerPropertyCases, AgreeWithTheScenarioFiles) {
   EXPECT_TRUE(freespace_finds) << "some case checks a freespace path";
 }
 
+// ---- the oracles themselves, on cases worked by hand ----
+
+Polygon square(double x0, double y0, double side) {
+  return {{x0, y0}, {x0 + side, y0}, {x0 + side, y0 + side}, {x0, y0 + side}};
+}
+
+TEST(PathOracles, SeparatingAxesAndDistanceOnWorkedCases) {
+  const Polygon unit = square(0, 0, 1);
+  // Side by side, 0.5 m apart: the x axis separates them by 0.5.
+  EXPECT_NEAR(separating_gap(unit, square(1.5, 0, 1)), 0.5, 1e-12);
+  EXPECT_NEAR(polygon_distance(unit, square(1.5, 0, 1)), 0.5, 1e-12);
+  // Corner to corner: the best axis gap is 1, the distance sqrt(2).
+  EXPECT_NEAR(separating_gap(unit, square(2, 2, 1)), 1.0, 1e-12);
+  EXPECT_NEAR(polygon_distance(unit, square(2, 2, 1)), std::sqrt(2.0), 1e-12);
+  // Overlapping and touching both count as contact.
+  EXPECT_TRUE(polygons_overlap(unit, square(0.5, 0.5, 1)));
+  EXPECT_TRUE(polygons_overlap(unit, square(1.0, 0.0, 1)));
+  EXPECT_DOUBLE_EQ(polygon_distance(unit, square(1.0, 0.0, 1)), 0.0);
+  // A diamond centred at (1.4, 1.4) with half diagonal 0.5: the bounding boxes overlap, only the
+  // diagonal axis separates; its edge x + y = 2.3 lies 0.3 / sqrt(2) from the corner (1, 1).
+  const Polygon diamond{{0.9, 1.4}, {1.4, 0.9}, {1.9, 1.4}, {1.4, 1.9}};
+  EXPECT_FALSE(polygons_overlap(unit, diamond));
+  EXPECT_NEAR(polygon_distance(unit, diamond), 0.3 / std::sqrt(2.0), 1e-12);
+  EXPECT_TRUE(polygons_overlap(unit, Polygon{{0.7, 1.2}, {1.2, 0.7}, {1.7, 1.2}, {1.2, 1.7}}));
+}
+
+TEST(PathOracles, GridCellsCurvatureAndInterpolationOnWorkedCases) {
+  OccupancyGrid g;
+  g.resolution_m = 1.0;
+  g.origin = {10.0, 20.0, 0.0};
+  g.width = 10;
+  g.height = 10;
+  g.data.assign(100, 0);
+  g.data[5 * 10 + 5] = 100;  // the cell [15, 16] x [25, 26]
+  EXPECT_FALSE(overlaps_grid(g, 30, square(13.0, 25.0, 1.9)));
+  EXPECT_TRUE(overlaps_grid(g, 30, square(13.0, 25.0, 2.0)));  // touches its side
+  EXPECT_TRUE(overlaps_grid(g, 30, square(9.5, 22.0, 1.0)));   // leaves the grid
+  g.data[5 * 10 + 5] = 29;                                     // below the threshold: free
+  EXPECT_FALSE(overlaps_grid(g, 30, square(13.0, 25.0, 2.0)));
+  // Three points of a circle of radius 5, turning left.
+  const auto on_circle = [](double a) { return Vec2(5.0 * std::cos(a), 5.0 * std::sin(a)); };
+  EXPECT_NEAR(menger_curvature(on_circle(0.0), on_circle(0.3), on_circle(0.7)), 0.2, 1e-12);
+  EXPECT_NEAR(menger_curvature(on_circle(0.7), on_circle(0.3), on_circle(0.0)), -0.2, 1e-12);
+  PathWithLaneId seg;
+  seg.points = {{{0.0, 0.0, 0.0}, 1.0, {}}, {{1.0, 0.0, 0.1}, 1.0, {}}};
+  const std::vector<Pose2> poses = poses_along(seg, 0.3);
+  ASSERT_EQ(poses.size(), 5u);  // 4 steps of 0.25 m and the end
+  EXPECT_NEAR(poses[1].x, 0.25, 1e-12);
+  EXPECT_NEAR(poses[2].yaw, 0.05, 1e-12);
+}
+
 // ---- each scenario with its own planner list: what its `expect:` says ----
 
 class ScenarioExpectations : public ::testing::TestWithParam<const char*> {};
