@@ -17,12 +17,14 @@ pullout::Scenario load(const std::string& name) {
   return pullout::load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/" + name + ".yaml");
 }
 
-void plan_scenario(benchmark::State& state, const std::string& name) {
+// deadline_ms < 0: no deadline.
+void plan_scenario(benchmark::State& state, const std::string& name, double deadline_ms = -1.0) {
   const pullout::Scenario scenario = load(name);
   const pullout::StartPlanner planner(scenario.vehicle, scenario.parameters);
   std::size_t attempts = 0;
   for (auto _ : state) {
-    const pullout::PlanningResult r = planner.plan(scenario.request, pullout::Deadline());
+    const pullout::PlanningResult r = planner.plan(
+        scenario.request, deadline_ms < 0.0 ? pullout::Deadline() : pullout::Deadline::after_ms(deadline_ms));
     attempts = r.evaluation_table.size();
     benchmark::DoNotOptimize(r.path.partial_paths.data());
   }
@@ -47,6 +49,11 @@ void BM_Plan_CarCloseAhead(benchmark::State& state) { plan_scenario(state, "car_
 // from the lanes and objects, end poses are searched on the lane ahead, and hybrid A* runs.
 void BM_Plan_FreespaceBoxedIn(benchmark::State& state) { plan_scenario(state, "freespace_boxed_in"); }
 void BM_Plan_FreespacePerpendicularBay(benchmark::State& state) { plan_scenario(state, "freespace_perpendicular_bay"); }
+// How promptly a search stops at its deadline: 1 ms for the freespace bay (costmap set-up plus the
+// search's check interval on top of it; the unit test only checks that it times out).
+void BM_Plan_FreespaceTinyDeadline(benchmark::State& state) {
+  plan_scenario(state, "freespace_perpendicular_bay", 1.0);
+}
 // A pure freespace problem: a grid and a goal pose, no lanes.
 void BM_Plan_FreespaceParkingLot(benchmark::State& state) { plan_scenario(state, "freespace_parking_lot"); }
 
@@ -60,6 +67,7 @@ BENCHMARK(BM_Plan_PerpendicularBay)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_CarCloseAhead)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_FreespaceBoxedIn)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_FreespacePerpendicularBay)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_FreespaceTinyDeadline)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_FreespaceParkingLot)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

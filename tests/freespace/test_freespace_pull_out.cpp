@@ -1,17 +1,18 @@
 // The freespace pull-out end to end (scenario files through the pipeline): what it returns must
-// be drivable. Oracles independent of the planner: the exact grid test of the footprint on a
-// costmap built here from the scenario, a plain polygon distance to the objects, Menger
-// curvature of consecutive points.
+// be drivable. Oracles independent of the planner (tests/planners/path_oracles.hpp), none of
+// them the planner's costmap or GridCollisionChecker: the footprint rectangle against the
+// objects' polygons (separating axes), against the request's occupied grid cells (each an exact
+// square) and inside the raw lane polygons, at every path point with the planner's margin and
+// every 2 cm between the points with the bare body; Menger curvature of consecutive points.
 #include "pullout/freespace/freespace_pull_out.hpp"
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 
+#include "../planners/path_oracles.hpp"
 #include "pullout/collision/footprint.hpp"
 #include "pullout/config/scenario.hpp"
-#include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 
@@ -55,18 +56,29 @@ TEST_P(FreespaceScenario, FindsADrivablePath) {
   EXPECT_NEAR(path.partial_paths[0].points[0].pose.x, sc.request.ego_pose.x, 1e-9);
   EXPECT_NEAR(path.partial_paths[0].points[0].pose.y, sc.request.ego_pose.y, 1e-9);
 
-  // The costmap the planner searched, rebuilt here, and the exact test of the grown footprint.
+  // What the planner promises: up to the end pose, the body grown by half of vehicle_shape_margin
+  // on every side touches no object, no occupied grid cell and stays inside the lanes (its
+  // costmap frees only cells entirely inside the lanes that no object touches). Between its
+  // points and on the road after the end pose at least the body touches nothing.
   const FreespaceParameters& fp = sc.parameters.freespace_planner;
   std::vector<Polygon> objects;
   for (const Object& o : sc.request.objects) objects.push_back(object_polygon(o));
-  const LaneWorld world(sc.request.lanes);
-  const Costmap costmap =
-      freespace_costmap(fp, sc.request.occupancy_grid ? &*sc.request.occupancy_grid : nullptr, &world, objects,
-                        sc.request.ego_pose, fp.end_pose_search_end_distance + sc.vehicle.length_m() + 10.0);
-  const GridCollisionChecker checker(costmap, freespace_footprint(sc.vehicle, fp));
+  std::vector<Polygon> lanes;
+  for (const Lane& l : sc.request.lanes) lanes.push_back(oracle::lane_polygon(l));
+  const OccupancyGrid* grid = sc.request.occupancy_grid ? &*sc.request.occupancy_grid : nullptr;
+  const int threshold = fp.costmap_configs.obstacle_threshold;
+  const Footprint body = vehicle_footprint(sc.vehicle);
+  // 1 mm less than the promise: the oracle's rounding, far below the 0.1 to 0.2 m margins.
+  const Footprint grown = vehicle_footprint(sc.vehicle, 0.5 * fp.vehicle_shape_margin - 1e-3);
+  const auto touches = [&](const Footprint& f, const Pose2& pose) {
+    const Polygon rect = oracle::rectangle_at(f, pose);
+    for (const Polygon& o : objects) {
+      if (oracle::polygons_overlap(rect, o)) return true;
+    }
+    return grid != nullptr && oracle::overlaps_grid(*grid, threshold, rect);
+  };
   const double k_max =
       1.0 / (sc.vehicle.wheel_base_m / std::tan(sc.vehicle.max_steer_angle_rad * fp.max_turning_ratio));
-  const Footprint body = vehicle_footprint(sc.vehicle);
 
   int cusps = 0;
   for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
@@ -99,22 +111,19 @@ TEST_P(FreespaceScenario, FindsADrivablePath) {
                                         (pose.y - path.end_pose.y) * std::sin(path.end_pose.yaw) >
                                     1e-6;
       if (!on_road_tail) {
-        EXPECT_FALSE(checker.collides(pose)) << "segment " << k << " point " << i;
-      }
-      const Polygon fp_poly = footprint_polygon(body, pose);
-      for (const Polygon& o : objects) {
-        for (const Vec2& c : fp_poly) EXPECT_FALSE(point_in_polygon(o, c)) << "segment " << k << " point " << i;
+        EXPECT_FALSE(touches(grown, pose)) << "margin, segment " << k << " point " << i;
+        if (!lanes.empty()) {
+          EXPECT_TRUE(oracle::footprint_in_lanes(grown, pose, lanes)) << "lanes, segment " << k << " point " << i;
+        }
       }
     }
+    for (const Pose2& pose : oracle::poses_along(seg, 0.02)) {
+      ASSERT_FALSE(touches(body, pose)) << "contact, segment " << k << " at (" << pose.x << ", " << pose.y << ")";
+    }
     for (std::size_t i = 1; i + 1 < seg.points.size(); ++i) {
-      const Vec2 a = to_vec(seg.points[i - 1].pose);
-      const Vec2 b = to_vec(seg.points[i].pose);
-      const Vec2 c = to_vec(seg.points[i + 1].pose);
-      const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-      const double denom = (b - a).norm() * (c - b).norm() * (c - a).norm();
-      if (denom > 1e-12) {
-        EXPECT_LE(std::abs(2.0 * cross / denom), k_max * 1.02) << "curvature, segment " << k << " point " << i;
-      }
+      const double kappa = oracle::menger_curvature(to_vec(seg.points[i - 1].pose), to_vec(seg.points[i].pose),
+                                                    to_vec(seg.points[i + 1].pose));
+      EXPECT_LE(std::abs(kappa), k_max * 1.02) << "curvature, segment " << k << " point " << i;
     }
   }
   RecordProperty("cusps", cusps);
@@ -150,15 +159,13 @@ TEST(FreespacePullOut, SplitsAtEveryCusp) {
   EXPECT_DOUBLE_EQ(s.pairs[1].accel_mps2, -2.25);
 }
 
-TEST(FreespacePullOut, TinyDeadlineGivesATimeoutPromptly) {
+// How long the stop takes is measured by bench/bench_planning (not asserted in a unit test).
+TEST(FreespacePullOut, TinyDeadlineGivesATimeout) {
   const Scenario sc = load("freespace_perpendicular_bay");
   const StartPlanner planner(sc.vehicle, sc.parameters);
-  const auto t0 = std::chrono::steady_clock::now();
   const PlanningResult r = planner.plan(sc.request, Deadline::after_ms(1.0));
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
   EXPECT_TRUE(r.timed_out);
-  EXPECT_LT(ms, 100.0);  // 1 ms budget + the costmap set-up, with slack for a loaded machine
 }
 
 TEST(FreespacePullOut, GridOnlyRequestsNeedTheFreespacePlanner) {

@@ -1,6 +1,8 @@
-// Independent oracles for found paths, shared by the property tests: a plain polygon distance
-// instead of FCL, and boundary sampling against raw lane polygons instead of the lane world's
-// outline.
+// Independent oracles for found paths, shared by the property tests: a separating-axis overlap
+// test and a vertex-to-edge distance instead of FCL or the freespace grid checker, boundary
+// sampling against raw lane polygons instead of the lane world's outline, Menger curvature of
+// three consecutive points, and poses interpolated between path points. Nothing here calls a
+// planner's collision checker.
 #pragma once
 
 #include <algorithm>
@@ -27,14 +29,71 @@ inline double point_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
   return (a + t * d - p).norm();
 }
 
-// Distance between two simple polygons, 0 when they touch or overlap.
-inline double polygon_distance(const Polygon& A, const Polygon& B) {
+// ---- separating-axis test (convex polygons) ----
+
+inline bool is_convex(const Polygon& p) {
+  if (p.size() < 3) return false;
+  double sign = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec2 e1 = p[(i + 1) % p.size()] - p[i];
+    const Vec2 e2 = p[(i + 2) % p.size()] - p[(i + 1) % p.size()];
+    const double c = e1.x() * e2.y() - e1.y() * e2.x();
+    if (c == 0.0) continue;
+    if (sign == 0.0) sign = c;
+    if ((c > 0.0) != (sign > 0.0)) return false;
+  }
+  return true;
+}
+
+// Largest gap [m] between the projections of two convex polygons on the normals of their edges:
+// > 0 means an axis separates them (they are disjoint), <= 0 means they overlap or touch (for
+// convex polygons some edge normal separates any disjoint pair). The gap is a lower bound of
+// their distance, exact when the closest features are an edge and a vertex facing it.
+inline double separating_gap(const Polygon& A, const Polygon& B) {
+  double best = -std::numeric_limits<double>::infinity();
+  const auto axes_of = [&](const Polygon& P) {
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      const Vec2 e = P[(i + 1) % P.size()] - P[i];
+      const double n = e.norm();
+      if (n < 1e-12) continue;
+      const Vec2 axis(-e.y() / n, e.x() / n);
+      double a_min = std::numeric_limits<double>::infinity(), a_max = -a_min;
+      double b_min = a_min, b_max = -a_min;
+      for (const Vec2& p : A) {
+        a_min = std::min(a_min, p.dot(axis));
+        a_max = std::max(a_max, p.dot(axis));
+      }
+      for (const Vec2& p : B) {
+        b_min = std::min(b_min, p.dot(axis));
+        b_max = std::max(b_max, p.dot(axis));
+      }
+      best = std::max(best, std::max(b_min - a_max, a_min - b_max));
+    }
+  };
+  axes_of(A);
+  axes_of(B);
+  return best;
+}
+
+inline bool convex_overlap(const Polygon& A, const Polygon& B) { return separating_gap(A, B) <= 0.0; }
+
+// Overlap of two simple polygons (touching counts): the separating-axis test when both are
+// convex, otherwise crossing edges or one polygon inside the other.
+inline bool polygons_overlap(const Polygon& A, const Polygon& B) {
+  if (is_convex(A) && is_convex(B)) return convex_overlap(A, B);
   for (std::size_t i = 0; i < A.size(); ++i) {
     for (std::size_t j = 0; j < B.size(); ++j) {
-      if (segments_cross(A[i], A[(i + 1) % A.size()], B[j], B[(j + 1) % B.size()])) return 0.0;
+      if (segments_cross(A[i], A[(i + 1) % A.size()], B[j], B[(j + 1) % B.size()])) return true;
     }
   }
-  if (point_in_polygon(A, B[0]) || point_in_polygon(B, A[0])) return 0.0;
+  return point_in_polygon(A, B[0]) || point_in_polygon(B, A[0]);
+}
+
+// Distance between two simple polygons, 0 when they touch or overlap: for disjoint polygons the
+// closest pair of points always includes a vertex of one of them, so the smallest vertex-to-edge
+// distance is exact.
+inline double polygon_distance(const Polygon& A, const Polygon& B) {
+  if (polygons_overlap(A, B)) return 0.0;
   double d = std::numeric_limits<double>::infinity();
   for (const Vec2& p : A) {
     for (std::size_t j = 0; j < B.size(); ++j) d = std::min(d, point_segment(p, B[j], B[(j + 1) % B.size()]));
@@ -69,6 +128,79 @@ inline bool footprint_in_lanes(const Footprint& f, const Pose2& pose, const std:
     }
   }
   return true;
+}
+
+// The rectangle front/rear/left/right [m] around base_link at `pose`, counter-clockwise; written
+// here rather than taken from the planners' footprint code.
+inline Polygon rectangle_at(double front, double rear, double left, double right, const Pose2& pose) {
+  const double c = std::cos(pose.yaw);
+  const double s = std::sin(pose.yaw);
+  const auto at = [&](double x, double y) { return Vec2(pose.x + c * x - s * y, pose.y + s * x + c * y); };
+  return {at(front, left), at(-rear, left), at(-rear, -right), at(front, -right)};
+}
+inline Polygon rectangle_at(const Footprint& f, const Pose2& pose) {
+  return rectangle_at(f.front, f.rear, f.left, f.right, pose);
+}
+
+// Curvature [1/m] of the circle through a, b, c (Menger curvature: 4 area / product of the
+// sides), signed (> 0 turning left); 0 for coincident points.
+inline double menger_curvature(const Vec2& a, const Vec2& b, const Vec2& c) {
+  const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  const double denom = (b - a).norm() * (c - b).norm() * (c - a).norm();
+  return denom < 1e-12 ? 0.0 : 2.0 * cross / denom;
+}
+
+// Poses between consecutive points of a segment, every `step` metres at most (position and
+// heading interpolated linearly, the heading the short way round), both ends included.
+inline std::vector<Pose2> poses_along(const PathWithLaneId& seg, double step) {
+  std::vector<Pose2> out;
+  for (std::size_t i = 0; i + 1 < seg.points.size(); ++i) {
+    const Pose2& a = seg.points[i].pose;
+    const Pose2& b = seg.points[i + 1].pose;
+    const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / step)));
+    const double dyaw = std::remainder(b.yaw - a.yaw, 2.0 * M_PI);
+    for (int k = 0; k < n; ++k) {
+      const double t = static_cast<double>(k) / n;
+      out.push_back({a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.yaw + t * dyaw});
+    }
+  }
+  if (!seg.points.empty()) out.push_back(seg.points.back().pose);
+  return out;
+}
+
+// Whether polygon `poly` (map frame) overlaps an occupied cell of the grid (unknown or >= threshold;
+// touching counts) or reaches outside the grid, which counts as occupied. Exact: the polygon is
+// taken into the grid frame, and each occupied cell under its bounding box is tested as a square
+// with the separating-axis test.
+inline bool overlaps_grid(const OccupancyGrid& g, int threshold, const Polygon& poly) {
+  const double c = std::cos(g.origin.yaw);
+  const double s = std::sin(g.origin.yaw);
+  Polygon local;
+  double x_min = std::numeric_limits<double>::infinity(), y_min = x_min, x_max = -x_min, y_max = -x_min;
+  for (const Vec2& p : poly) {
+    const double dx = p.x() - g.origin.x;
+    const double dy = p.y() - g.origin.y;
+    local.emplace_back(c * dx + s * dy, -s * dx + c * dy);
+    x_min = std::min(x_min, local.back().x());
+    x_max = std::max(x_max, local.back().x());
+    y_min = std::min(y_min, local.back().y());
+    y_max = std::max(y_max, local.back().y());
+  }
+  const double r = g.resolution_m;
+  if (x_min < 0.0 || y_min < 0.0 || x_max > g.width * r || y_max > g.height * r) return true;
+  const int i0 = std::max(0, static_cast<int>(std::floor(x_min / r)) - 1);
+  const int i1 = std::min(static_cast<int>(g.width) - 1, static_cast<int>(std::floor(x_max / r)) + 1);
+  const int j0 = std::max(0, static_cast<int>(std::floor(y_min / r)) - 1);
+  const int j1 = std::min(static_cast<int>(g.height) - 1, static_cast<int>(std::floor(y_max / r)) + 1);
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) {
+      const int v = g.data[static_cast<std::size_t>(j) * g.width + i];
+      if (v >= 0 && v < threshold) continue;
+      const Polygon cell{{i * r, j * r}, {(i + 1) * r, j * r}, {(i + 1) * r, (j + 1) * r}, {i * r, (j + 1) * r}};
+      if (convex_overlap(cell, local)) return true;
+    }
+  }
+  return false;
 }
 
 inline double direction_of(const PathWithLaneId& seg) {

@@ -1,12 +1,13 @@
-// Properties of every planner on every scenario file: whatever a planner returns as found must be
-// a path a vehicle can drive. The oracles here are independent of the planners' own checks: a
-// plain polygon distance instead of FCL, and boundary sampling against the raw lane polygons
-// instead of the lane world's outline.
+// Properties of every planner on the scenario files: each case states whether its planner finds
+// a path there, and what it returns as found must be a path a vehicle can drive. The oracles
+// (path_oracles.hpp) are independent of the planners' own checks: a separating-axis overlap test
+// and a vertex-to-edge distance instead of FCL or the freespace grid checker, boundary sampling
+// against the raw lane polygons instead of the lane world's outline, Menger curvature of three
+// consecutive points.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
-#include <tuple>
 
 #include "path_oracles.hpp"
 #include "pullout/collision/footprint.hpp"
@@ -19,41 +20,104 @@ namespace {
 
 using namespace oracle;  // NOLINT: the test's own helpers
 
-const char* const kScenarios[] = {"straight_shoulder", "curved_road",       "parked_car_ahead",      "boxed_in",
-                                  "parallel_spot",     "perpendicular_bay", "parallel_spot_reverse", "car_close_ahead",
-                                  "full_search"};
-const PlannerType kPlanners[] = {PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid};
-
 Scenario load(const std::string& name) {
   return load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/" + name + ".yaml");
 }
 
+// One planner on one scenario. A lane planner (shift, geometric, clothoid) runs alone: it is the
+// only entry of search_priority and the freespace fallback is off, so a found path is its own.
+// kFreespace runs the scenario's own planner list, in which the lane planners fail and the
+// freespace fallback must win.
+struct PropertyCase {
+  const char* scenario;
+  PlannerType planner;
+  bool found;  // whether this planner finds a path here (consistent with the file's `expect:`)
+};
+
+std::ostream& operator<<(std::ostream& os, const PropertyCase& c) {
+  return os << c.scenario << "/" << to_string(c.planner) << (c.found ? " finds" : " finds nothing");
+}
+
+const PropertyCase kCases[] = {
+    {"straight_shoulder", PlannerType::kShift, true},
+    {"straight_shoulder", PlannerType::kGeometric, false},
+    {"straight_shoulder", PlannerType::kClothoid, true},
+    {"curved_road", PlannerType::kShift, true},
+    {"curved_road", PlannerType::kGeometric, false},
+    {"curved_road", PlannerType::kClothoid, true},
+    {"parked_car_ahead", PlannerType::kShift, true},
+    {"parked_car_ahead", PlannerType::kGeometric, false},
+    {"parked_car_ahead", PlannerType::kClothoid, true},
+    {"boxed_in", PlannerType::kShift, false},
+    {"boxed_in", PlannerType::kGeometric, false},
+    {"boxed_in", PlannerType::kClothoid, false},
+    {"parallel_spot", PlannerType::kShift, false},
+    {"parallel_spot", PlannerType::kGeometric, true},
+    {"parallel_spot", PlannerType::kClothoid, true},
+    {"perpendicular_bay", PlannerType::kShift, false},
+    {"perpendicular_bay", PlannerType::kGeometric, true},
+    {"perpendicular_bay", PlannerType::kClothoid, true},
+    {"parallel_spot_reverse", PlannerType::kShift, true},
+    {"parallel_spot_reverse", PlannerType::kGeometric, true},
+    {"parallel_spot_reverse", PlannerType::kClothoid, true},
+    {"car_close_ahead", PlannerType::kShift, true},
+    {"car_close_ahead", PlannerType::kGeometric, false},
+    {"car_close_ahead", PlannerType::kClothoid, true},
+    {"full_search", PlannerType::kShift, false},
+    {"full_search", PlannerType::kGeometric, false},
+    {"full_search", PlannerType::kClothoid, false},
+    {"clothoid_only", PlannerType::kClothoid, true},
+    {"freespace_boxed_in", PlannerType::kFreespace, true},
+    {"freespace_perpendicular_bay", PlannerType::kFreespace, true},
+    {"freespace_parking_lot", PlannerType::kFreespace, true},
+};
+
+// The scenario's parameters and request for the case. A scenario's `planner: search_priority`
+// is also a request override (so that a scenario sent to the service plans the same), which would
+// win over the parameters: the request's override names the case's planner too.
+StartPlannerParameters case_parameters(const Scenario& sc, PlannerType planner) {
+  StartPlannerParameters params = sc.parameters;
+  if (planner != PlannerType::kFreespace) {
+    params.search_priority = {planner};
+    params.freespace_planner.enable_freespace_planner = false;
+  }
+  return params;
+}
+PullOutRequest case_request(const Scenario& sc, PlannerType planner) {
+  PullOutRequest request = sc.request;
+  if (planner != PlannerType::kFreespace) request.overrides.search_priority = {planner};
+  return request;
+}
+
 // ---- the property test ----
 
-class PlannerProperties : public ::testing::TestWithParam<std::tuple<const char*, PlannerType>> {};
+class PlannerProperties : public ::testing::TestWithParam<PropertyCase> {};
 
 TEST_P(PlannerProperties, FoundPathsAreDrivable) {
-  const auto [name, planner_type] = GetParam();
-  const Scenario sc = load(name);
-  StartPlannerParameters params = sc.parameters;
-  params.search_priority = {planner_type};
+  const PropertyCase& c = GetParam();
+  const Scenario sc = load(c.scenario);
+  const StartPlannerParameters params = case_parameters(sc, c.planner);
   const StartPlanner planner(sc.vehicle, params);
-  const PlanningResult r = planner.plan(sc.request, Deadline());
-  if (r.outcome != PlanningResult::Outcome::kFound) {
-    // Not finding a path is allowed; it must come as a stop path with reasons.
+  const PlanningResult r = planner.plan(case_request(sc, c.planner), Deadline());
+  if (!c.found) {
+    // Nothing to find: it must come as a stop path with reasons.
+    ASSERT_NE(r.outcome, PlanningResult::Outcome::kFound) << to_string(r.path.planner_type) << " found a path";
     EXPECT_FALSE(r.path.found);
     EXPECT_EQ(r.path.planner_type, PlannerType::kStop);
     EXPECT_FALSE(r.path.reasons.empty());
+    ASSERT_FALSE(r.path.partial_paths.empty());
     for (const auto& p : r.path.partial_paths.at(0).points) EXPECT_DOUBLE_EQ(p.longitudinal_velocity_mps, 0.0);
-    RecordProperty("found", "false");
     return;
   }
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << "expected a path: " << r.stop_reason;
   const PullOutPath& path = r.path;
   ASSERT_TRUE(path.found);
+  ASSERT_EQ(path.planner_type, c.planner) << "the path comes from another planner";
   ASSERT_GE(path.partial_paths.size(), 1u);
   ASSERT_EQ(path.pairs_terminal_velocity_and_accel.size(), path.partial_paths.size()) << "one pair per segment";
-  const double margin = r.evaluation_table.back().margin_m;
   ASSERT_EQ(r.evaluation_table.back().outcome, "success");
+  const bool freespace = c.planner == PlannerType::kFreespace;
+  const FreespaceParameters& fp = params.freespace_planner;
 
   // Starts at the vehicle.
   EXPECT_NEAR(path.partial_paths[0].points[0].pose.x, sc.request.ego_pose.x, 1e-9);
@@ -61,20 +125,27 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
 
   std::vector<Polygon> obstacles;
   for (const Object& o : sc.request.objects) obstacles.push_back(object_polygon(o));
+  const OccupancyGrid* grid = sc.request.occupancy_grid ? &*sc.request.occupancy_grid : nullptr;
+  const int threshold = fp.costmap_configs.obstacle_threshold;
   std::vector<Polygon> lanes;
   for (const Lane& l : sc.request.lanes) lanes.push_back(lane_polygon(l));
-  const Footprint footprint = vehicle_footprint(sc.vehicle);
-  const double expansion = planner_type == PlannerType::kGeometric ? params.lane_departure_margin
-                                                                   : params.lane_departure_check_expansion_margin;
+  const Footprint body = vehicle_footprint(sc.vehicle);
+  // The clearance each planner promises up to the end pose: the winning margin of a lane planner;
+  // for freespace, the footprint grown by half of vehicle_shape_margin is clear of every occupied
+  // cell, and the costmap marks every cell an object touches, so the body keeps that distance.
+  const double margin = freespace ? 0.5 * fp.vehicle_shape_margin : r.evaluation_table.back().margin_m;
+  // The footprint that must stay inside the lanes: the lane planners' departure expansion; the
+  // freespace costmap frees only cells entirely inside the lanes.
+  const double expansion = freespace                              ? 0.5 * fp.vehicle_shape_margin
+                           : c.planner == PlannerType::kGeometric ? params.lane_departure_margin
+                                                                  : params.lane_departure_check_expansion_margin;
   const Footprint lane_footprint = vehicle_footprint(sc.vehicle, expansion);
-  // Where the margin applies: up to the end pose, minus 10 m for shift
+  // Where the margin applies: up to the end pose, plus 10 m for shift
   // (shift_collision_check_distance_from_end); beyond that only contact is excluded.
   const double margin_until_end =
-      planner_type == PlannerType::kShift ? params.shift_collision_check_distance_from_end : 0.0;
-  bool passed_end = false;
-  double forward_distance = 0.0;
-  double end_distance = -1.0;
+      c.planner == PlannerType::kShift ? params.shift_collision_check_distance_from_end : 0.0;
   // Distance from the forward start to the end pose, to know where the margin section ends.
+  double end_distance = -1.0;
   {
     double d = 0.0;
     for (const auto& seg : path.partial_paths) {
@@ -91,6 +162,15 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
     ASSERT_GE(end_distance, 0.0) << "end_pose is a point of the path";
   }
 
+  const auto clearance_at = [&](const Pose2& pose) {
+    double clearance = std::numeric_limits<double>::infinity();
+    const Polygon rect = rectangle_at(body, pose);
+    for (const Polygon& o : obstacles) clearance = std::min(clearance, polygon_distance(rect, o));
+    return clearance;
+  };
+
+  bool passed_end = false;
+  double forward_distance = 0.0;
   for (std::size_t k = 0; k < path.partial_paths.size() && !passed_end; ++k) {
     const PathWithLaneId& seg = path.partial_paths[k];
     ASSERT_GE(seg.points.size(), 2u) << "segment " << k;
@@ -114,45 +194,133 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
       if (dir > 0.0 && i > 0) {
         forward_distance += std::hypot(pose.x - seg.points[i - 1].pose.x, pose.y - seg.points[i - 1].pose.y);
       }
-      double clearance = std::numeric_limits<double>::infinity();
-      for (const Polygon& o : obstacles)
-        clearance = std::min(clearance, polygon_distance(footprint_polygon(footprint, pose), o));
+      const double clearance = clearance_at(pose);
       EXPECT_GT(clearance, 0.0) << "contact at segment " << k << " point " << i;
-      if (dir > 0.0 && forward_distance <= end_distance + margin_until_end + 1e-9) {
+      const bool margin_applies =
+          freespace || (dir > 0.0 && forward_distance <= end_distance + margin_until_end + 1e-9);
+      if (margin_applies) {
         // 1e-3: FCL's GJK and this oracle agree to well below a millimetre.
         EXPECT_GE(clearance, margin - 1e-3) << "margin at segment " << k << " point " << i;
       }
-      EXPECT_TRUE(footprint_in_lanes(lane_footprint, pose, lanes))
-          << "lane departure at segment " << k << " point " << i;
+      if (grid != nullptr) {
+        // The grid's occupied cells: the footprint grown by the margin touches none of them.
+        const Footprint grown = vehicle_footprint(sc.vehicle, margin_applies ? margin - 1e-3 : 0.0);
+        EXPECT_FALSE(overlaps_grid(*grid, threshold, rectangle_at(grown, pose)))
+            << "occupied cell at segment " << k << " point " << i;
+      }
+      if (!lanes.empty()) {
+        EXPECT_TRUE(footprint_in_lanes(lane_footprint, pose, lanes))
+            << "lane departure at segment " << k << " point " << i;
+      }
       if (dir > 0.0 && std::hypot(pose.x - path.end_pose.x, pose.y - path.end_pose.y) < 1e-6) {
         passed_end = true;
         break;
       }
     }
   }
+  // Between the points too, every 5 cm: the body never touches an object (the whole path).
+  for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
+    for (const Pose2& pose : poses_along(path.partial_paths[k], 0.05)) {
+      ASSERT_GT(clearance_at(pose), 0.0) << "contact between the points of segment " << k << " at (" << pose.x << ", "
+                                         << pose.y << ")";
+      if (grid != nullptr) {
+        ASSERT_FALSE(overlaps_grid(*grid, threshold, rectangle_at(body, pose)))
+            << "occupied cell between the points of segment " << k << " at (" << pose.x << ", " << pose.y << ")";
+      }
+    }
+  }
 
-  // Curvature of the turns within the vehicle's limit (Menger curvature of consecutive points).
-  const double k_max = 1.0 / sc.vehicle.min_turning_radius_m();
-  for (const auto& seg : path.partial_paths) {
-    for (std::size_t i = 1; i + 1 < seg.points.size(); ++i) {
-      const Vec2 a = to_vec(seg.points[i - 1].pose);
-      const Vec2 b = to_vec(seg.points[i].pose);
-      const Vec2 c = to_vec(seg.points[i + 1].pose);
-      const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-      const double denom = (b - a).norm() * (c - b).norm() * (c - a).norm();
-      if (denom < 1e-12) continue;
-      EXPECT_LE(std::abs(2.0 * cross / denom), k_max * 1.02) << "curvature at point " << i;
+  // Curvature within the vehicle's limit (freespace: its own max_turning_ratio of the steering),
+  // from three consecutive points; 2 % covers the chords of the sampled arcs.
+  const double k_max = freespace
+                           ? std::tan(sc.vehicle.max_steer_angle_rad * fp.max_turning_ratio) / sc.vehicle.wheel_base_m
+                           : 1.0 / sc.vehicle.min_turning_radius_m();
+  for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
+    const auto& pts = path.partial_paths[k].points;
+    for (std::size_t i = 1; i + 1 < pts.size(); ++i) {
+      const double kappa = menger_curvature(to_vec(pts[i - 1].pose), to_vec(pts[i].pose), to_vec(pts[i + 1].pose));
+      EXPECT_LE(std::abs(kappa), k_max * 1.02) << "curvature at segment " << k << " point " << i;
     }
   }
 }
 
-std::string param_name(const ::testing::TestParamInfo<PlannerProperties::ParamType>& info) {
-  return std::string(std::get<0>(info.param)) + "_" + to_string(std::get<1>(info.param));
+std::string param_name(const ::testing::TestParamInfo<PropertyCase>& info) {
+  return std::string(info.param.scenario) + "_" + to_string(info.param.planner);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllPlannersAllScenarios, PlannerProperties,
-                         ::testing::Combine(::testing::ValuesIn(kScenarios), ::testing::ValuesIn(kPlanners)),
-                         param_name);
+INSTANTIATE_TEST_SUITE_P(Scenarios, PlannerProperties, ::testing::ValuesIn(kCases), param_name);
+
+// The case table against the files: a scenario that expects no path has no case that finds one,
+// and the planner a file expects to win finds a path alone.
+TEST(PlannerPropertyCases, AgreeWithTheScenarioFiles) {
+  bool clothoid_finds = false;
+  bool freespace_finds = false;
+  for (const PropertyCase& c : kCases) {
+    const Scenario sc = load(c.scenario);
+    ASSERT_TRUE(sc.expect.found.has_value()) << c.scenario << " states whether a path exists";
+    if (!*sc.expect.found) {
+      EXPECT_FALSE(c.found) << c;
+    }
+    if (sc.expect.planner == c.planner) {
+      EXPECT_TRUE(c.found) << c;
+    }
+    clothoid_finds = clothoid_finds || (c.found && c.planner == PlannerType::kClothoid);
+    freespace_finds = freespace_finds || (c.found && c.planner == PlannerType::kFreespace);
+  }
+  EXPECT_TRUE(clothoid_finds) << "some case checks a clothoid path";
+  EXPECT_TRUE(freespace_finds) << "some case checks a freespace path";
+}
+
+// ---- the oracles themselves, on cases worked by hand ----
+
+Polygon square(double x0, double y0, double side) {
+  return {{x0, y0}, {x0 + side, y0}, {x0 + side, y0 + side}, {x0, y0 + side}};
+}
+
+TEST(PathOracles, SeparatingAxesAndDistanceOnWorkedCases) {
+  const Polygon unit = square(0, 0, 1);
+  // Side by side, 0.5 m apart: the x axis separates them by 0.5.
+  EXPECT_NEAR(separating_gap(unit, square(1.5, 0, 1)), 0.5, 1e-12);
+  EXPECT_NEAR(polygon_distance(unit, square(1.5, 0, 1)), 0.5, 1e-12);
+  // Corner to corner: the best axis gap is 1, the distance sqrt(2).
+  EXPECT_NEAR(separating_gap(unit, square(2, 2, 1)), 1.0, 1e-12);
+  EXPECT_NEAR(polygon_distance(unit, square(2, 2, 1)), std::sqrt(2.0), 1e-12);
+  // Overlapping and touching both count as contact.
+  EXPECT_TRUE(polygons_overlap(unit, square(0.5, 0.5, 1)));
+  EXPECT_TRUE(polygons_overlap(unit, square(1.0, 0.0, 1)));
+  EXPECT_DOUBLE_EQ(polygon_distance(unit, square(1.0, 0.0, 1)), 0.0);
+  // A diamond centred at (1.4, 1.4) with half diagonal 0.5: the bounding boxes overlap, only the
+  // diagonal axis separates; its edge x + y = 2.3 lies 0.3 / sqrt(2) from the corner (1, 1).
+  const Polygon diamond{{0.9, 1.4}, {1.4, 0.9}, {1.9, 1.4}, {1.4, 1.9}};
+  EXPECT_FALSE(polygons_overlap(unit, diamond));
+  EXPECT_NEAR(polygon_distance(unit, diamond), 0.3 / std::sqrt(2.0), 1e-12);
+  EXPECT_TRUE(polygons_overlap(unit, Polygon{{0.7, 1.2}, {1.2, 0.7}, {1.7, 1.2}, {1.2, 1.7}}));
+}
+
+TEST(PathOracles, GridCellsCurvatureAndInterpolationOnWorkedCases) {
+  OccupancyGrid g;
+  g.resolution_m = 1.0;
+  g.origin = {10.0, 20.0, 0.0};
+  g.width = 10;
+  g.height = 10;
+  g.data.assign(100, 0);
+  g.data[5 * 10 + 5] = 100;  // the cell [15, 16] x [25, 26]
+  EXPECT_FALSE(overlaps_grid(g, 30, square(13.0, 25.0, 1.9)));
+  EXPECT_TRUE(overlaps_grid(g, 30, square(13.0, 25.0, 2.0)));  // touches its side
+  EXPECT_TRUE(overlaps_grid(g, 30, square(9.5, 22.0, 1.0)));   // leaves the grid
+  g.data[5 * 10 + 5] = 29;                                     // below the threshold: free
+  EXPECT_FALSE(overlaps_grid(g, 30, square(13.0, 25.0, 2.0)));
+  // Three points of a circle of radius 5, turning left.
+  const auto on_circle = [](double a) { return Vec2(5.0 * std::cos(a), 5.0 * std::sin(a)); };
+  EXPECT_NEAR(menger_curvature(on_circle(0.0), on_circle(0.3), on_circle(0.7)), 0.2, 1e-12);
+  EXPECT_NEAR(menger_curvature(on_circle(0.7), on_circle(0.3), on_circle(0.0)), -0.2, 1e-12);
+  PathWithLaneId seg;
+  seg.points = {{{0.0, 0.0, 0.0}, 1.0, {}}, {{1.0, 0.0, 0.1}, 1.0, {}}};
+  const std::vector<Pose2> poses = poses_along(seg, 0.3);
+  ASSERT_EQ(poses.size(), 5u);  // 4 steps of 0.25 m and the end
+  EXPECT_NEAR(poses[1].x, 0.25, 1e-12);
+  EXPECT_NEAR(poses[2].yaw, 0.05, 1e-12);
+}
 
 // ---- each scenario with its own planner list: what its `expect:` says ----
 
@@ -178,8 +346,9 @@ TEST_P(ScenarioExpectations, MatchTheFile) {
 
 // The map scenarios too (their path properties are checked in test_map_planning.cpp).
 const char* const kExpectationScenarios[] = {
-    "straight_shoulder", "curved_road",           "parked_car_ahead", "boxed_in",    "parallel_spot",
-    "perpendicular_bay", "parallel_spot_reverse", "car_close_ahead",  "full_search", "map_shoulder"};
+    "straight_shoulder", "curved_road",       "parked_car_ahead",      "boxed_in",
+    "parallel_spot",     "perpendicular_bay", "parallel_spot_reverse", "car_close_ahead",
+    "full_search",       "map_shoulder",      "clothoid_only"};
 INSTANTIATE_TEST_SUITE_P(Bundled, ScenarioExpectations, ::testing::ValuesIn(kExpectationScenarios));
 
 TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {

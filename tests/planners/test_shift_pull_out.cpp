@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "pullout/geometry/polyline.hpp"
+#include "path_oracles.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "test_world.hpp"
 
@@ -34,7 +34,8 @@ TEST(ShiftFormulas, WorkedNumbersAt60KmH) {
     EXPECT_NEAR(k.shift_time, expected_time[i], 0.0006) << "a_lat " << samples[i];
     EXPECT_DOUBLE_EQ(k.longitudinal_acc, 1.0);
     EXPECT_NEAR(k.distance, expected_distance[i], kTableTolerance) << "a_lat " << samples[i];
-    EXPECT_NEAR(k.terminal_velocity, k.shift_time, 0.01) << "v_term = a_lon T with a_lon = 1";
+    // d = a_lon T^2 / 2 here, so v_term = sqrt(2 a_lon d) = a_lon T = T (the table's T, 3 decimals).
+    EXPECT_NEAR(k.terminal_velocity, expected_time[i], 0.0006) << "a_lat " << samples[i];
   }
 }
 
@@ -50,15 +51,43 @@ TEST(ShiftFormulas, ShiftTimeIsInfiniteForNonPositiveLimits) {
   EXPECT_TRUE(std::isinf(calc_shift_time_from_jerk(3.5, 0.5, 0.0)));
 }
 
-TEST(LateralJerkProfile, ReachesTheShiftLengthAtRestWithinTheAccelerationLimit) {
+// The constant-jerk profile in closed form. Jerk +j, 0, -j over t_j, t_a, t_j brings the lateral
+// acceleration up to a = j t_j and back to 0, the lateral velocity to its peak a (t_j + t_a); the
+// second half mirrors the first. Integrating phase by phase, the first half covers
+// a t_j^2 + 3/2 a t_j t_a + 1/2 a t_a^2, so the whole shift covers
+//   L = a (t_j + t_a) (2 t_j + t_a)                                               (*)
+// and the first phase alone j t_j^3 / 6. The checks below hold the profile to (*) and to these
+// phase values; they are exact up to rounding (1e-9 on metres and seconds).
+TEST(LateralJerkProfile, MatchesTheClosedFormOfTheConstantJerkShift) {
   for (double L : {0.2, 1.0, 3.5, 8.0}) {
     for (double a : {0.15, 0.3, 0.5}) {
-      const auto prof = LateralJerkProfile::from_limits(L, 0.5, a);
+      const double j = 0.5;
+      const auto prof = LateralJerkProfile::from_limits(L, j, a);
+      const double t_j = prof.t_jerk;
+      const double t_a = prof.t_accel;
+      const double a_peak = j * t_j;
+      EXPECT_NEAR(prof.jerk, j, 1e-12);
+      EXPECT_GE(t_a, 0.0);
+      EXPECT_LE(a_peak, a + 1e-12) << "L " << L << " a " << a;
+      // Either the acceleration limit is reached (t_j = a / j) or there is no constant phase.
+      if (t_a > 1e-12) {
+        EXPECT_NEAR(t_j, a / j, 1e-12);
+      }
+      EXPECT_NEAR(a_peak * (t_j + t_a) * (2.0 * t_j + t_a), L, 1e-9) << "(*) L " << L << " a " << a;
+      EXPECT_NEAR(prof.total_time(), 4.0 * t_j + 2.0 * t_a, 1e-12);
+      // Phase values: end of the first jerk phase, the middle (half way at peak velocity), the end.
+      const auto p1 = prof.at(t_j);
+      EXPECT_NEAR(p1.position, j * t_j * t_j * t_j / 6.0, 1e-9);
+      EXPECT_NEAR(p1.velocity, 0.5 * j * t_j * t_j, 1e-9);
+      EXPECT_NEAR(p1.acceleration, a_peak, 1e-9);
+      const auto mid = prof.at(0.5 * prof.total_time());
+      EXPECT_NEAR(mid.position, 0.5 * L, 1e-9);
+      EXPECT_NEAR(mid.velocity, a_peak * (t_j + t_a), 1e-9);
+      EXPECT_NEAR(mid.acceleration, 0.0, 1e-9);
       const auto end = prof.at(prof.total_time());
       EXPECT_NEAR(end.position, L, 1e-9) << "L " << L << " a " << a;
       EXPECT_NEAR(end.velocity, 0.0, 1e-9);
       EXPECT_NEAR(end.acceleration, 0.0, 1e-9);
-      EXPECT_LE(prof.peak_acceleration(), a + 1e-12);
       // Position never decreases and never overshoots.
       double prev = 0.0;
       for (int i = 0; i <= 200; ++i) {
@@ -71,14 +100,26 @@ TEST(LateralJerkProfile, ReachesTheShiftLengthAtRestWithinTheAccelerationLimit) 
   }
 }
 
+// Worked numbers: L = 3.5 m, a_lat = 0.5, j = 0.5, v_road = 16.67, maximum_curvature = 0.01.
+//   t_j = a / j = 1 s; (*) gives t_a^2 + 3 t_a + 2 = L / a = 7, so
+//   t_a = (-3 + sqrt(9 + 20)) / 2 = 1.19258 s and T = 4 t_j + 2 t_a = 6.38516 s;
+//   a_lon = min(16.67 / T, 1) = 1; a_lon T^2 / 2 = 20.385 m; the curvature term (peak curvature
+//   a_peak T^2 / d^2 = maximum_curvature) d = T sqrt(0.5 / 0.01) = 45.150 m dominates;
+//   v_term = sqrt(2 a_lon d) = 9.5026 m/s. Computed here from the numbers, so 1e-9.
 TEST(ShiftFormulas, CurvatureTermDominatesForShortHighAccelerationShifts) {
   StartPlannerParameters p;
   p.maximum_curvature = 0.01;
+  ASSERT_DOUBLE_EQ(p.lateral_jerk, 0.5);
+  const double t_a = (std::sqrt(29.0) - 3.0) / 2.0;
+  const double T = 4.0 + 2.0 * t_a;
+  const double d = T * std::sqrt(0.5 / 0.01);
   const ShiftKinematics k = compute_shift_kinematics(3.5, 0.5, 16.67, p);
-  const double by_curvature = k.shift_time * std::sqrt(k.profile.peak_acceleration() / 0.01);
-  EXPECT_NEAR(k.distance, by_curvature, 1e-9);
-  EXPECT_GT(k.distance, 0.5 * k.shift_time * k.shift_time);
-  EXPECT_NEAR(k.terminal_velocity, std::sqrt(2.0 * k.longitudinal_acc * k.distance), 1e-9);
+  EXPECT_NEAR(k.shift_time, T, 1e-9);
+  EXPECT_NEAR(T, 6.38516, 1e-5);
+  EXPECT_DOUBLE_EQ(k.longitudinal_acc, 1.0);
+  EXPECT_NEAR(k.distance, d, 1e-9);
+  EXPECT_NEAR(d, 45.150, 1e-3);
+  EXPECT_NEAR(k.terminal_velocity, std::sqrt(2.0 * d), 1e-9);
 }
 
 // ---- planner properties ----
@@ -97,11 +138,10 @@ PathProperties measure(const PathWithLaneId& path, std::size_t first, std::size_
     m.max_step = std::max(m.max_step, std::hypot(b.x - a.x, b.y - a.y));
     m.max_yaw_jump = std::max(m.max_yaw_jump, std::abs(normalize_angle(b.yaw - a.yaw)));
   }
-  std::vector<Vec2> pts;
-  for (std::size_t i = first; i <= last; ++i) pts.push_back(to_vec(path.points[i].pose));
-  const Polyline line(pts);
-  for (std::size_t i = 1; i + 1 < line.size(); ++i) {
-    m.max_curvature = std::max(m.max_curvature, std::abs(line.curvature_at(line.s(i))));
+  for (std::size_t i = first + 1; i < last; ++i) {
+    const double kappa = oracle::menger_curvature(to_vec(path.points[i - 1].pose), to_vec(path.points[i].pose),
+                                                  to_vec(path.points[i + 1].pose));
+    m.max_curvature = std::max(m.max_curvature, std::abs(kappa));
   }
   return m;
 }
@@ -166,15 +206,23 @@ TEST(ShiftPullOut, StraightShoulderPathIsContinuousAndEndsOnTheCenterline) {
   ASSERT_EQ(r.evaluation_table.size(), 1u);
   EXPECT_EQ(r.evaluation_table[0].outcome, "success");
   EXPECT_DOUBLE_EQ(r.evaluation_table[0].margin_m, 2.0);
-  const auto k = compute_shift_kinematics(3.25, 0.15, 13.89, StartPlannerParameters{});
-  EXPECT_NEAR(path.pairs_terminal_velocity_and_accel[0].velocity_mps, k.terminal_velocity, 1e-9);
-  EXPECT_NEAR(path.pairs_terminal_velocity_and_accel[0].accel_mps2, k.longitudinal_acc, 1e-9);
+  // Worked numbers for L = 3.25 m, a_lat = 0.15, j = 0.5, v_road = 13.89: t_j = a / j = 0.3 s;
+  // the closed form L = a (t_j + t_a) (2 t_j + t_a) gives t_a^2 + 0.9 t_a + 0.18 = 3.25 / 0.15,
+  // t_a = (-0.9 + sqrt(0.81 - 4 (0.18 - 21.667))) / 2 = 4.2072 s, T = 4 t_j + 2 t_a = 9.6143 s;
+  // a_lon = min(13.89 / T, 1) = 1; d = max(T^2 / 2 = 46.218 m, T sqrt(0.15 / 0.07) = 14.07 m)
+  // = 46.218 m; v_term = min(13.89, sqrt(2 d)) = T = 9.6143 m/s. Formulas evaluated here: 1e-9.
+  const double t_a = (-0.9 + std::sqrt(0.81 - 4.0 * (0.18 - 3.25 / 0.15))) / 2.0;
+  const double T = 1.2 + 2.0 * t_a;
+  const double shift_distance = 0.5 * T * T;
+  ASSERT_NEAR(T, 9.6143, 1e-4);
+  EXPECT_NEAR(path.pairs_terminal_velocity_and_accel[0].velocity_mps, T, 1e-9);
+  EXPECT_DOUBLE_EQ(path.pairs_terminal_velocity_and_accel[0].accel_mps2, 1.0);
   // The shift section is as long as the kinematics say (within one sample of arc length).
   double len = 0.0;
   for (std::size_t i = 1; i <= end_idx; ++i) {
     len += std::hypot(seg.points[i].pose.x - seg.points[i - 1].pose.x, seg.points[i].pose.y - seg.points[i - 1].pose.y);
   }
-  EXPECT_NEAR(len, k.distance, 0.05);
+  EXPECT_NEAR(len, shift_distance, 0.05);
 }
 
 TEST(ShiftPullOut, CurvedRoadStaysWithinTheSteeringLimitAndEndsOnTheCenterline) {
