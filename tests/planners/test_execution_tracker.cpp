@@ -1,4 +1,4 @@
-#include "pullout/pipeline/execution_tracker.hpp"
+#include "pullout/execution/execution_tracker.hpp"
 
 #include <gtest/gtest.h>
 
@@ -41,7 +41,7 @@ ExecutionProgress at(double x, double v, double t_s, std::uint64_t request_id = 
 }
 
 TEST(ExecutionTracker, AdvancesOnlyAfterStoppingNearTheSegmentEnd) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   t.start(two_segment_path());
   EXPECT_FALSE(t.on_progress(at(8.0, -1.0, 0.0)).changed);
   // Arrived near the end of the reverse leg but still moving.
@@ -56,14 +56,14 @@ TEST(ExecutionTracker, AdvancesOnlyAfterStoppingNearTheSegmentEnd) {
 }
 
 TEST(ExecutionTracker, StoppingFarFromTheEndDoesNotAdvance) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   t.start(two_segment_path());
   for (int i = 0; i < 5; ++i) EXPECT_FALSE(t.on_progress(at(7.0, 0.0, i)).changed);
   EXPECT_EQ(t.current_path_idx(), 0u);
 }
 
 TEST(ExecutionTracker, CompletesWhenPassingTheEndPoseOfTheLastSegment) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   t.start(two_segment_path());
   t.on_progress(at(5.0, 0.0, 0.0));
   ASSERT_TRUE(t.on_progress(at(5.0, 0.0, 1.5)).changed);
@@ -78,7 +78,7 @@ TEST(ExecutionTracker, CompletesWhenPassingTheEndPoseOfTheLastSegment) {
 }
 
 TEST(ExecutionTracker, IgnoresOtherRequestsAndClampsTheIndex) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   PullOutPath single = two_segment_path();
   single.partial_paths.erase(single.partial_paths.begin());
   single.pairs_terminal_velocity_and_accel.erase(single.pairs_terminal_velocity_and_accel.begin());
@@ -93,7 +93,7 @@ TEST(ExecutionTracker, IgnoresOtherRequestsAndClampsTheIndex) {
 }
 
 TEST(ExecutionTracker, ReverseLastSegmentCompletesBehindTheEndPose) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   PullOutPath p;
   p.request_id = 1;
   p.partial_paths = {segment(10, 2, -1.0)};

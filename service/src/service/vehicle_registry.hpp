@@ -36,8 +36,8 @@
 #include <utility>
 #include <vector>
 
+#include "pullout/execution/execution_tracker.hpp"
 #include "pullout/model/types.hpp"
-#include "pullout/pipeline/execution_tracker.hpp"
 #include "pullout/pipeline/parameters.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "pullout/safety/safety_monitor.hpp"
