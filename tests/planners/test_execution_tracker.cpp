@@ -1,4 +1,4 @@
-#include "pullout/pipeline/execution_tracker.hpp"
+#include "pullout/execution/execution_tracker.hpp"
 
 #include <gtest/gtest.h>
 
@@ -48,7 +48,7 @@ ExecutionTracker::Update feed(ExecutionTracker& t, const ExecutionProgress& p) {
 }
 
 TEST(ExecutionTracker, AdvancesOnlyAfterStoppingNearTheSegmentEnd) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   t.start(two_segment_path());
   EXPECT_FALSE(feed(t, at(8.0, -1.0, 0.0)).changed);
   // Arrived near the end of the reverse leg but still moving.
@@ -63,14 +63,14 @@ TEST(ExecutionTracker, AdvancesOnlyAfterStoppingNearTheSegmentEnd) {
 }
 
 TEST(ExecutionTracker, StoppingFarFromTheEndDoesNotAdvance) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   t.start(two_segment_path());
   for (int i = 0; i < 5; ++i) EXPECT_FALSE(feed(t, at(7.0, 0.0, i)).changed);
   EXPECT_EQ(t.current_path_idx(), 0u);
 }
 
 TEST(ExecutionTracker, CompletesWhenPassingTheEndPoseOfTheLastSegment) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   t.start(two_segment_path());
   feed(t, at(5.0, 0.0, 0.0));
   ASSERT_TRUE(feed(t, at(5.0, 0.0, 1.5)).changed);
@@ -85,7 +85,7 @@ TEST(ExecutionTracker, CompletesWhenPassingTheEndPoseOfTheLastSegment) {
 }
 
 TEST(ExecutionTracker, IgnoresOtherRequestsAndClampsTheIndex) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   PullOutPath single = two_segment_path();
   single.partial_paths.erase(single.partial_paths.begin());
   single.pairs_terminal_velocity_and_accel.erase(single.pairs_terminal_velocity_and_accel.begin());
@@ -100,7 +100,7 @@ TEST(ExecutionTracker, IgnoresOtherRequestsAndClampsTheIndex) {
 }
 
 TEST(ExecutionTracker, ReverseLastSegmentCompletesBehindTheEndPose) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   PullOutPath p;
   p.request_id = 1;
   p.partial_paths = {segment(10, 2, -1.0)};

@@ -1,4 +1,4 @@
-#include "pullout/planners/shift_pull_out.hpp"
+#include "pullout/lane_planners/shift_pull_out.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pullout/planners/two_turn_path.hpp"
+#include "pullout/lane_planners/two_turn_path.hpp"
 
 #include <gtest/gtest.h>
 

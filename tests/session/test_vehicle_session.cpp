@@ -9,7 +9,7 @@
 #include <string>
 
 #include "pullout/config/scenario.hpp"
-#include "pullout/pipeline/deadline.hpp"
+#include "pullout/search/deadline.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "pullout/session/vehicle_session.hpp"
 #include "test_world.hpp"

@@ -1,0 +1,78 @@
+// The freespace pull-out: a hybrid A* path (hybrid_astar.hpp) out of a spot the lane-based
+// planners cannot leave (boxed in between cars, a parking lot), to an end pose on the road lane
+// ahead, joined to the road centerline.
+//
+// As in Autoware's start planner (freespace_planner.*):
+//  - costmap: the request's occupancy grid (values >= costmap_configs.obstacle_threshold or
+//    unknown are obstacles), else the lanes (drivable) and the static objects rasterised at
+//    costmap_configs.resolution over a window around the vehicle; static objects are added to a
+//    grid too;
+//  - vehicle: the footprint grown by vehicle_shape_margin (half on each side), steering limited
+//    to max_steer_angle x max_turning_ratio;
+//  - end poses: on the road centerline from s(ego) + end_pose_search_start_distance to
+//    s(ego) + end_pose_search_end_distance every end_pose_search_interval; the first one reached
+//    wins;
+//  - output: the path split at every change of direction (the cusp point ends one partial path
+//    and starts the next), +/- velocity on the points and 0 at every cusp; the last forward
+//    partial path trimmed within 1 m of the end pose when the search stopped in the goal region
+//    (not exactly on the end pose) and continued on the road centerline; unlike Autoware, one
+//    velocity/acceleration pair per partial path.
+//
+// Failure modes are values: PlannerCandidates::failure names the search's status ("start
+// occupied", "timeout", ...). The search budget is freespace_planner.time_limit, cut short by the
+// deadline.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pullout/freespace/costmap.hpp"
+#include "pullout/freespace/freespace_parameters.hpp"
+#include "pullout/freespace/hybrid_astar.hpp"
+#include "pullout/lane_planners/pull_out_planner.hpp"
+
+namespace pullout {
+
+class FreespacePullOut : public PullOutPlanner {
+ public:
+  explicit FreespacePullOut(const FreespaceParameters& parameters) : parameters_(parameters) {}
+  PlannerType type() const override { return PlannerType::kFreespace; }
+  // One candidate at most. Plans from the current pose only (context.ego): a backward start
+  // candidate gets a failure, the search itself reverses where needed.
+  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const Deadline& deadline) const override;
+
+ private:
+  FreespaceParameters parameters_;
+};
+
+// The search settings the freespace parameters imply for this vehicle.
+HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const FreespaceParameters& parameters);
+// The vehicle footprint grown by vehicle_shape_margin (half on each side).
+Footprint freespace_footprint(const VehicleInfo& vehicle, const FreespaceParameters& parameters);
+
+// The costmap of a request: the grid with the obstacles added, or (grid == nullptr) the lanes of
+// `world` and the obstacles over the square window of half size `half_window` [m] around
+// `centre`, clipped to the lanes' bounding box.
+Costmap freespace_costmap(const FreespaceParameters& parameters, const OccupancyGrid* grid, const LaneWorld* world,
+                          const std::vector<Polygon>& obstacles, const Pose2& centre, double half_window);
+
+// Waypoints -> partial paths split at every change of direction: velocity direction x velocity,
+// 0 on the last point of each partial path; one pair per partial path ({+/-v, +/-v^2 / L}: v
+// reached at half of it, stopped at its end).
+struct SplitPath {
+  std::vector<PathWithLaneId> partial_paths;
+  std::vector<TerminalVelocityAccel> pairs;
+  std::vector<int> directions;  // per partial path
+};
+SplitPath split_at_cusps(const std::vector<Waypoint>& waypoints, double velocity);
+
+// A pure freespace problem (no lanes): from start straight to goal on the costmap.
+struct FreespaceGoalResult {
+  HybridAStarResult::Status status{HybridAStarResult::Status::kNoPath};
+  PullOutPath path;  // found: partial paths to the goal (end_pose = goal)
+};
+FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const VehicleInfo& vehicle,
+                                           const FreespaceParameters& parameters, const Pose2& start, const Pose2& goal,
+                                           const Deadline& deadline);
+
+}  // namespace pullout

@@ -1,0 +1,112 @@
+// Hybrid A*: a search over continuous vehicle poses (x, y, heading) bucketed into a lattice.
+//
+// D. Dolgov, S. Thrun, M. Montemerlo, J. Diebel, "Path Planning for Autonomous Vehicles in
+// Unknown Semi-structured Environments", IJRR 29(5), 2010.
+//
+// Each expansion drives a motion primitive from a node's exact pose: an arc of `primitive_length`
+// forwards (and, with use_back, backwards) at each of 2 * turning_steps + 1 curvatures between
+// -1/turning_radius and +1/turning_radius. A node keeps its exact pose; the lattice cell
+// (xy_resolution, 2 pi / theta_size) only decides which of two nodes survives. The default cell
+// is one primitive long: on the freespace benchmark (bench/RESULTS.md) it halves the median time
+// of a cell of primitive_length / sqrt(2) at the same success rate and path length. From time to time
+// (more often near the goal) a Reeds-Shepp path is shot from the node to the exact goal
+// ("analytic expansion"); the first collision-free one ends the search. Reaching the goal region
+// (goal tolerances, in the goal frame) ends it too.
+//
+// Cost of a primitive of length l: l * (1 + curve_weight * |steer| / turning_steps) *
+// (1 + reverse_weight when reversing), plus direction_change_weight [m] when it changes the
+// direction of travel. Heuristic: distance_heuristic_weight * max(Reeds-Shepp distance to the goal
+// without obstacles, 8-connected Dijkstra distance from the goal over the cells the rear axle can
+// occupy, on a grid of lattice cells). Weights above 1 trade optimality for speed: the default 2.0
+// is Autoware's; the heuristic ignores the cost weights, so with 1.0 the search floods every state
+// whose detour is below the true cost's excess (bench/RESULTS.md has the figures). The Dijkstra
+// distance also charges extra for narrow places (narrow_heuristic_penalty): gaps the rear axle
+// fits through but the vehicle cannot turn into otherwise draw the search in.
+//
+// The pose the search expands from is known to be free, with a clearance bound kept in its node:
+// the primitives from it are only checked beyond it.
+//
+// Collision: the poses the search stops at (nodes, the goal) are tested exactly against the
+// costmap (GridCollisionChecker). The motion between them is covered completely, conservatively:
+// the footprint grown by half a cell, tested at poses spaced so that the body cannot leave the
+// grown rectangle in between (see arc_free in search_support.hpp), and where that refuses, grown
+// by an eighth of a cell in four times as many tests; the clearance bound of a test skips the
+// stretch it proves free. So a returned path is collision-free at every point, not only at its
+// samples, and a motion is refused only if it passes within an eighth of a cell of an obstacle.
+//
+// Failure modes are values (Status), never exceptions. The deadline is checked between
+// expansions; the search returns kTimeout promptly after it expires.
+//
+// Thread safety: plan() is const and may run concurrently (all search state is local).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "pullout/freespace/grid_collision_checker.hpp"
+#include "pullout/model/types.hpp"
+#include "pullout/search/deadline.hpp"
+
+namespace pullout {
+
+struct HybridAStarConfig {
+  double turning_radius{5.0};    // [m] radius of the sharpest primitive and of the shots, > 0
+  int turning_steps{1};          // curvatures per side: steer index -turning_steps..turning_steps
+  int theta_size{120};           // heading bins of the lattice
+  double primitive_length{0.5};  // [m] arc length of one motion primitive
+  double xy_resolution{0.0};     // [m] lattice cell; 0 = primitive_length (see the note above)
+  bool use_back{true};           // expand reverse primitives
+  double curve_weight{0.5};
+  double reverse_weight{1.0};
+  double direction_change_weight{1.5};    // [m] added per change of driving direction
+  double distance_heuristic_weight{2.0};  // Autoware start planner default
+  // The obstacle-aware distance charges up to (1 + this) per metre in places with less room than
+  // half the footprint's diagonal (see the note above); 0 = the plain distance.
+  double narrow_heuristic_penalty{3.0};
+  // Goal region, in the goal frame: |longitudinal| <= longitudinal_goal_range / 2, ...
+  double longitudinal_goal_range{2.0};  // [m]
+  double lateral_goal_range{0.5};       // [m]
+  double angle_goal_range{0.10472};     // [rad] (6 deg)
+  std::size_t max_nodes{4000000};       // memory bound: no path when exceeded
+  double waypoint_interval{0.25};       // [m] spacing of the returned waypoints (at most)
+  // Debugging aid: when set, every expanded pose is appended here, in expansion order (a picture
+  // of where the search spent its time). Not thread safe: one plan() per vector.
+  std::vector<Pose2>* expanded_poses{nullptr};
+};
+
+struct Waypoint {
+  Pose2 pose;
+  // Direction of travel on the way to this waypoint (+1 forward, -1 reverse); the first waypoint
+  // carries the direction of the first motion.
+  int direction{1};
+};
+
+struct HybridAStarResult {
+  enum class Status { kSuccess, kStartOccupied, kGoalOccupied, kTimeout, kNoPath };
+  Status status{Status::kNoPath};
+  std::vector<Waypoint> waypoints;  // start ... goal (or the pose in the goal region)
+  double length{0.0};               // [m] driven, both directions
+  std::size_t expansions{0};
+  std::size_t nodes{0};
+  std::size_t shots{0};            // Reeds-Shepp analytic expansions tried
+  bool reached_exact_goal{false};  // by a Reeds-Shepp shot (else: inside the goal region)
+};
+
+const char* to_string(HybridAStarResult::Status status);
+
+class HybridAStar {
+ public:
+  // The checker (and its costmap) must outlive the planner.
+  HybridAStar(const GridCollisionChecker& checker, const HybridAStarConfig& config);
+
+  HybridAStarResult plan(const Pose2& start, const Pose2& goal, const Deadline& deadline) const;
+
+  const HybridAStarConfig& config() const { return config_; }
+
+ private:
+  const GridCollisionChecker& checker_;
+  HybridAStarConfig config_;
+};
+
+}  // namespace pullout

@@ -1,0 +1,227 @@
+#include "pullout/freespace/freespace_pull_out.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "pullout/freespace/grid_collision_checker.hpp"
+
+namespace pullout {
+
+namespace {
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr double kTrimDistance = 1.0;  // [m] Autoware's trim around the end pose
+constexpr double kSamePose = 1e-6;     // [m]
+constexpr double kWindowExtra = 10.0;  // [m] costmap window beyond the farthest end pose
+
+Deadline search_deadline(const FreespaceParameters& p, const Deadline& deadline) {
+  const Deadline own = Deadline::after_ms(p.time_limit);
+  return own.at() < deadline.at() ? Deadline(own.at(), nullptr) : deadline;
+}
+
+double path_length(const PathWithLaneId& path) {
+  double len = 0.0;
+  for (std::size_t i = 1; i < path.points.size(); ++i) {
+    len += std::hypot(path.points[i].pose.x - path.points[i - 1].pose.x,
+                      path.points[i].pose.y - path.points[i - 1].pose.y);
+  }
+  return len;
+}
+
+// The pair of a partial path that stops at its end: v reached at half of it (a = v^2 / L).
+TerminalVelocityAccel stopping_pair(double v, double length) {
+  return {v, length > 1e-9 ? v * std::abs(v) / length : 0.0};
+}
+
+}  // namespace
+
+HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const FreespaceParameters& p) {
+  HybridAStarConfig c;
+  c.turning_radius = vehicle.wheel_base_m / std::tan(vehicle.max_steer_angle_rad * p.max_turning_ratio);
+  c.turning_steps = p.turning_steps;
+  c.theta_size = p.search_configs.theta_size;
+  c.primitive_length = p.astar.expansion_distance;
+  c.use_back = p.astar.use_back;
+  c.curve_weight = p.search_configs.curve_weight;
+  c.reverse_weight = p.search_configs.reverse_weight;
+  c.direction_change_weight = p.search_configs.direction_change_weight;
+  c.distance_heuristic_weight = p.astar.distance_heuristic_weight;
+  c.narrow_heuristic_penalty = p.astar.narrow_heuristic_penalty;
+  c.longitudinal_goal_range = p.search_configs.longitudinal_goal_range;
+  c.lateral_goal_range = p.search_configs.lateral_goal_range;
+  c.angle_goal_range = p.search_configs.angle_goal_range * kDegToRad;
+  return c;
+}
+
+Footprint freespace_footprint(const VehicleInfo& vehicle, const FreespaceParameters& p) {
+  return vehicle_footprint(vehicle, 0.5 * p.vehicle_shape_margin);
+}
+
+Costmap freespace_costmap(const FreespaceParameters& p, const OccupancyGrid* grid, const LaneWorld* world,
+                          const std::vector<Polygon>& obstacles, const Pose2& centre, double half_window) {
+  if (grid != nullptr) {
+    Costmap map = Costmap::from_occupancy_grid(*grid, p.costmap_configs.obstacle_threshold);
+    if (!obstacles.empty()) map.add_obstacles(obstacles);
+    return map;
+  }
+  Aabb lanes_box;
+  std::vector<Polygon> drivable;
+  for (const LaneGeometry& lane : world->lanes()) {
+    drivable.push_back(lane.polygon);
+    lanes_box.extend(lane.box.min);
+    lanes_box.extend(lane.box.max);
+  }
+  Aabb extent;
+  extent.min = lanes_box.min.cwiseMax(Vec2{centre.x - half_window, centre.y - half_window});
+  extent.max = lanes_box.max.cwiseMin(Vec2{centre.x + half_window, centre.y + half_window});
+  extent = extent.inflated(p.costmap_configs.resolution);  // a blocked rim around the lanes
+  return Costmap::from_polygons(extent, p.costmap_configs.resolution, drivable, world->outer_edges(), obstacles);
+}
+
+SplitPath split_at_cusps(const std::vector<Waypoint>& w, double velocity) {
+  SplitPath out;
+  std::size_t first = 0;
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    // Waypoint i ends a partial path when the motion after it goes the other way (or it is last).
+    const bool last = i + 1 == w.size();
+    if (!last && w[i + 1].direction == w[i].direction) continue;
+    PathWithLaneId part;
+    const int dir = w[i].direction;
+    for (std::size_t k = first; k <= i; ++k) {
+      PathPoint pt;
+      pt.pose = w[k].pose;
+      pt.longitudinal_velocity_mps = k == i ? 0.0 : dir * velocity;
+      part.points.push_back(std::move(pt));
+    }
+    out.pairs.push_back(stopping_pair(dir * velocity, path_length(part)));
+    out.partial_paths.push_back(std::move(part));
+    out.directions.push_back(dir);
+    first = i;
+  }
+  return out;
+}
+
+FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const VehicleInfo& vehicle,
+                                           const FreespaceParameters& p, const Pose2& start, const Pose2& goal,
+                                           const Deadline& deadline) {
+  FreespaceGoalResult out;
+  const GridCollisionChecker checker(costmap, freespace_footprint(vehicle, p));
+  HybridAStarConfig config = freespace_search_config(vehicle, p);
+  const HybridAStarResult r = HybridAStar(checker, config).plan(start, goal, search_deadline(p, deadline));
+  out.status = r.status;
+  if (r.status != HybridAStarResult::Status::kSuccess) return out;
+  SplitPath split = split_at_cusps(r.waypoints, p.velocity);
+  out.path.partial_paths = std::move(split.partial_paths);
+  out.path.pairs_terminal_velocity_and_accel = std::move(split.pairs);
+  out.path.start_pose = start;
+  out.path.end_pose = r.waypoints.back().pose;
+  out.path.found = true;
+  out.path.planner_type = PlannerType::kFreespace;
+  return out;
+}
+
+PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2& start,
+                                         const Deadline& deadline) const {
+  PlannerCandidates out;
+  if (std::hypot(start.x - ctx.ego.x, start.y - ctx.ego.y) > kSamePose) {
+    out.failure = "freespace plans from the current pose only";
+    return out;
+  }
+  const FreespaceParameters& p = parameters_;
+  const Deadline until = search_deadline(p, deadline);
+  const std::vector<Polygon> no_obstacles;
+  const std::vector<Polygon>& obstacles = ctx.obstacle_polygons != nullptr ? *ctx.obstacle_polygons : no_obstacles;
+  const double half_window = p.end_pose_search_end_distance + ctx.vehicle.length_m() + kWindowExtra;
+  // The costmap and the search are shared by every end pose; heavy, so built once.
+  const Costmap costmap = freespace_costmap(p, ctx.occupancy_grid, &ctx.world, obstacles, ctx.ego, half_window);
+  const GridCollisionChecker checker(costmap, freespace_footprint(ctx.vehicle, p));
+  const HybridAStar search(checker, freespace_search_config(ctx.vehicle, p));
+
+  const Polyline& center = ctx.road.centerline;
+  const double s_ego = center.project(to_vec(ctx.ego)).s;
+  std::string last_failure = "no end pose on the road ahead";
+  for (double d = p.end_pose_search_start_distance; d <= p.end_pose_search_end_distance + 1e-9;
+       d += p.end_pose_search_interval) {
+    const double s_end = s_ego + d;
+    if (s_end > center.length()) break;
+    if (until.expired()) {
+      out.timed_out = true;
+      break;
+    }
+    const Pose2 end_pose = center.pose_at(s_end);
+    HybridAStarResult r = search.plan(start, end_pose, until);
+    if (r.status == HybridAStarResult::Status::kTimeout) {
+      out.timed_out = true;
+      break;
+    }
+    if (r.status != HybridAStarResult::Status::kSuccess) {
+      last_failure = std::string("end pose ") + format_fixed(d, 1) + " m ahead: " + to_string(r.status);
+      continue;
+    }
+    PathCandidate candidate;
+    std::vector<Pose2> poses;
+    for (const Waypoint& w : r.waypoints) poses.push_back(w.pose);
+    const auto clearance = section_clearance(ctx, poses, 0, poses.size() - 1);
+    candidate.clearance = clearance.distance;
+    candidate.nearest_obstacle = clearance.obstacle_id;
+    const PlanningContext* c = &ctx;
+    candidate.build = [c, fp = p, waypoints = std::move(r.waypoints), exact = r.reached_exact_goal, end_pose, s_end,
+                       s_ego]() {
+      SplitPath split = split_at_cusps(waypoints, fp.velocity);
+      const std::int64_t fallback_id = road_lane_id_at(*c, s_ego);
+      PathWithLaneId& last = split.partial_paths.back();
+      // Road points follow from one interval after tail_from.
+      double tail_from = s_end;
+      if (split.directions.back() > 0) {
+        // Continue the last forward partial path on the centerline (trimmed when the search
+        // stopped in the goal region rather than on the end pose).
+        if (!exact) {
+          auto& pts = last.points;
+          for (std::size_t i = 1; i < pts.size(); ++i) {
+            if (std::hypot(pts[i].pose.x - end_pose.x, pts[i].pose.y - end_pose.y) < kTrimDistance) {
+              pts.erase(pts.begin() + static_cast<std::ptrdiff_t>(i), pts.end());
+              break;
+            }
+          }
+          tail_from = s_end + kTrimDistance - c->parameters.center_line_path_interval;
+        }
+        last.points.back().longitudinal_velocity_mps = fp.velocity;
+      } else {
+        // Arrived in reverse: the road part is a partial path of its own, from the end pose.
+        PathWithLaneId road;
+        PathPoint first;
+        first.pose = last.points.back().pose;
+        first.longitudinal_velocity_mps = fp.velocity;
+        road.points.push_back(first);
+        split.partial_paths.push_back(std::move(road));
+        split.pairs.push_back({});
+        split.directions.push_back(1);
+      }
+      PathWithLaneId& forward = split.partial_paths.back();
+      const RoadEnd end = find_path_end(*c, s_end);
+      std::vector<PathPoint> tail = centerline_points(*c, tail_from, end);
+      for (auto& pt : tail) forward.points.push_back(std::move(pt));
+      if (forward.points.size() < 2) forward.points.push_back(forward.points.back());
+      // The last partial path accelerates to the freespace velocity over its freespace part.
+      const double len = std::max(1e-3, path_length(forward));
+      split.pairs.back() = {fp.velocity, fp.velocity * fp.velocity / (2.0 * len)};
+      PullOutPath path;
+      for (auto& part : split.partial_paths) {
+        for (auto& pt : part.points) pt.lane_ids = lane_ids_at(*c, to_vec(pt.pose), fallback_id);
+      }
+      path.partial_paths = std::move(split.partial_paths);
+      path.pairs_terminal_velocity_and_accel = std::move(split.pairs);
+      path.start_pose = waypoints.front().pose;
+      path.end_pose = end_pose;
+      path.shift_length_m = c->road.centerline.project(to_vec(waypoints.front().pose)).lateral;
+      return path;
+    };
+    out.candidates.push_back(std::move(candidate));
+    return out;
+  }
+  out.failure = out.timed_out ? "timeout" : last_failure;
+  return out;
+}
+
+}  // namespace pullout

@@ -1,0 +1,299 @@
+#include "pullout/lane_planners/shift_pull_out.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "pullout/collision/footprint.hpp"
+
+namespace pullout {
+
+namespace {
+
+constexpr double kMinShiftLength = 0.01;        // [m] below this the start is on the centerline
+constexpr double kMaxStartYawDeviation = 0.35;  // [rad] (20 deg) between start heading and lane
+
+// Arc length where the shift may end: the first centerline position at or after s0 whose
+// curvature is below the threshold, or the least curved one if none is (so that the shift does
+// not end in the middle of a bend).
+double push_end_to_low_curvature(const Polyline& center, double s0, double threshold) {
+  if (std::abs(center.curvature_at(s0)) < threshold) return s0;
+  double best_s = s0;
+  double best_k = std::abs(center.curvature_at(s0));
+  for (std::size_t i = 0; i < center.size(); ++i) {
+    if (center.s(i) <= s0) continue;
+    const double k = std::abs(center.curvature_at(center.s(i)));
+    if (k < threshold) return center.s(i);
+    if (k < best_k) {
+      best_k = k;
+      best_s = center.s(i);
+    }
+  }
+  return best_s;
+}
+
+// Lateral offset l and its derivative dl/ds of the shifted path at centerline arc length s.
+struct Offset {
+  double l{0.0};
+  double dl{0.0};
+};
+
+class ShiftShape {
+ public:
+  ShiftShape(const LateralJerkProfile& profile, double shift_length, double s_begin, double length)
+      : profile_(profile),
+        total_(profile.at(profile.total_time()).position),
+        shift_length_(shift_length),
+        s_begin_(s_begin),
+        length_(length) {}
+
+  Offset at(double s) const {
+    if (s >= s_begin_ + length_) return {};
+    const double u = std::clamp((s - s_begin_) / length_, 0.0, 1.0);
+    const double time = u * profile_.total_time();
+    const auto st = profile_.at(time);
+    const double p = st.position / total_;
+    const double dp_du = st.velocity * profile_.total_time() / total_;
+    return {shift_length_ * (1.0 - p), -shift_length_ * dp_du / length_};
+  }
+
+  double end() const { return s_begin_ + length_; }
+
+ private:
+  LateralJerkProfile profile_;
+  double total_;
+  double shift_length_;
+  double s_begin_;
+  double length_;
+};
+
+Pose2 shifted_pose(const Polyline& center, double s, const Offset& o) {
+  const Polyline::Sample c = center.sample_at(s);
+  const Vec2 base = to_vec(c.pose);
+  const double yaw_c = c.pose.yaw;
+  const double k = c.curvature;
+  const Vec2 p = base + left_normal(heading(yaw_c)) * o.l;
+  // Tangent of base + n(s) l(s): t (1 - k l) + n l'.
+  return {p.x(), p.y(), normalize_angle(yaw_c + std::atan2(o.dl, 1.0 - k * o.l))};
+}
+
+// Path length of the shifted section over centerline length `length` from s_begin.
+double shifted_length(const Polyline& center, const ShiftShape& shape, double s_begin, double length) {
+  constexpr int kSteps = 64;
+  double total = 0.0;
+  Vec2 prev = to_vec(shifted_pose(center, s_begin, shape.at(s_begin)));
+  for (int i = 1; i <= kSteps; ++i) {
+    const double s = s_begin + length * i / kSteps;
+    const Vec2 p = to_vec(shifted_pose(center, s, shape.at(s)));
+    total += (p - prev).norm();
+    prev = p;
+  }
+  return total;
+}
+
+struct Candidate {
+  std::vector<Pose2> poses;
+  std::vector<double> s;  // centerline arc length of each pose
+  std::size_t shift_end_index{0};
+};
+
+// Arc lengths from s_start to the path end every center_line_path_interval, with the shift end
+// included exactly; poses for those up to `s_poses_until` only (the checks need no more; the
+// winner gets the rest in extend_poses).
+Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, double s_start, const RoadEnd& end,
+                       double s_poses_until) {
+  const double step = ctx.parameters.center_line_path_interval;
+  Candidate c;
+  for (double s = s_start; s < end.s - 1e-6; s += step) c.s.push_back(s);
+  c.s.push_back(end.s);
+  if (shape.end() > s_start && shape.end() < end.s) {
+    const auto it = std::lower_bound(c.s.begin(), c.s.end(), shape.end());
+    if (std::abs(*it - shape.end()) > 1e-6 && (it == c.s.begin() || std::abs(*(it - 1) - shape.end()) > 1e-6)) {
+      c.s.insert(it, shape.end());
+    }
+  }
+  for (std::size_t i = 0; i < c.s.size(); ++i) {
+    if (c.s[i] <= shape.end() + 1e-9) c.shift_end_index = i;
+  }
+  c.poses.reserve(c.s.size());
+  for (std::size_t i = 0; i < c.s.size() && (i == 0 || c.s[i] <= s_poses_until + 1e-9); ++i) {
+    c.poses.push_back(shifted_pose(ctx.road.centerline, c.s[i], shape.at(c.s[i])));
+  }
+  return c;
+}
+
+// Beyond the shift the path is the centerline itself.
+void extend_poses(const PlanningContext& ctx, Candidate& c) {
+  for (std::size_t i = c.poses.size(); i < c.s.size(); ++i) c.poses.push_back(ctx.road.centerline.pose_at(c.s[i]));
+}
+
+// Velocities: capped at v_term up to the shift end, the lane speed limit after it, 0 at the goal.
+PathWithLaneId to_path(const PlanningContext& ctx, const Candidate& c, const RoadEnd& end, double v_term) {
+  PathWithLaneId path;
+  path.points.resize(c.poses.size());
+  for (std::size_t i = 0; i < c.poses.size(); ++i) {
+    PathPoint& pt = path.points[i];
+    pt.pose = c.poses[i];
+    const double limit = speed_limit_at(ctx, c.s[i]);
+    pt.longitudinal_velocity_mps = i <= c.shift_end_index ? std::min(limit, v_term) : limit;
+    pt.lane_ids = lane_ids_at(ctx, to_vec(pt.pose), road_lane_id_at(ctx, c.s[i]));
+  }
+  if (end.is_goal) path.points.back().longitudinal_velocity_mps = 0.0;
+  return path;
+}
+
+}  // namespace
+
+LateralJerkProfile LateralJerkProfile::from_limits(double shift_length, double lateral_jerk, double lateral_acc) {
+  const double L = std::abs(shift_length);
+  const double j = lateral_jerk;
+  const double a = lateral_acc;
+  LateralJerkProfile p{j, a / j, (std::sqrt(a * a + 4.0 * j * j * L / a) - 3.0 * a) / (2.0 * j)};
+  if (p.t_accel < 0.0) {
+    // The acceleration limit is never reached: a pure jerk profile (peak j t_j < a).
+    p.t_jerk = std::cbrt(L / (2.0 * j));
+    p.t_accel = 0.0;
+  }
+  return p;
+}
+
+LateralJerkProfile::State LateralJerkProfile::at(double t) const {
+  const double durations[6] = {t_jerk, t_accel, t_jerk, t_jerk, t_accel, t_jerk};
+  const double jerks[6] = {jerk, 0.0, -jerk, -jerk, 0.0, jerk};
+  State s;
+  double remaining = std::clamp(t, 0.0, total_time());
+  for (int k = 0; k < 6 && remaining > 0.0; ++k) {
+    const double dt = std::min(remaining, durations[k]);
+    const double jk = jerks[k];
+    s.position += s.velocity * dt + s.acceleration * dt * dt / 2.0 + jk * dt * dt * dt / 6.0;
+    s.velocity += s.acceleration * dt + jk * dt * dt / 2.0;
+    s.acceleration += jk * dt;
+    remaining -= dt;
+  }
+  return s;
+}
+
+double calc_shift_time_from_jerk(double shift_length, double lateral_jerk, double lateral_acc) {
+  if (lateral_jerk <= 0.0 || lateral_acc <= 0.0) return std::numeric_limits<double>::infinity();
+  return LateralJerkProfile::from_limits(shift_length, lateral_jerk, lateral_acc).total_time();
+}
+
+ShiftKinematics compute_shift_kinematics(double shift_length, double lateral_acc, double road_velocity,
+                                         const LanePlannerParameters& p) {
+  ShiftKinematics k;
+  k.lateral_acc = lateral_acc;
+  k.profile = LateralJerkProfile::from_limits(shift_length, p.lateral_jerk, lateral_acc);
+  k.shift_time = k.profile.total_time();
+  const double T = k.shift_time;
+  k.longitudinal_acc = std::clamp(road_velocity / T, 0.0, p.maximum_longitudinal_acc);
+  const double by_acceleration = 0.5 * k.longitudinal_acc * T * T;
+  const double by_curvature = T * std::sqrt(k.profile.peak_acceleration() / p.maximum_curvature);
+  k.distance = std::max({by_acceleration, by_curvature, p.minimum_shift_pull_out_distance});
+  k.terminal_velocity = std::min(road_velocity, std::sqrt(2.0 * k.longitudinal_acc * k.distance));
+  return k;
+}
+
+std::vector<double> lateral_acc_samples(const LanePlannerParameters& p) {
+  std::vector<double> out;
+  const int n = std::max(p.lateral_acceleration_sampling_num, 1);
+  if (p.maximum_lateral_acc - p.minimum_lateral_acc < 1e-9) return {p.minimum_lateral_acc};
+  for (int i = 0; i <= n; ++i) {
+    out.push_back(p.minimum_lateral_acc + (p.maximum_lateral_acc - p.minimum_lateral_acc) * i / n);
+  }
+  return out;
+}
+
+PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start, const Deadline& deadline) const {
+  const auto& params = ctx.parameters;
+  const Polyline& center = ctx.road.centerline;
+  PlannerCandidates out;
+  if (center.size() < 2) {
+    out.failure = "no road centerline";
+    return out;
+  }
+  const auto proj = center.project(to_vec(start));
+  const double s_start = proj.s;
+  const double shift_length = proj.lateral;
+  if (s_start < 0.0 || s_start >= center.length()) {
+    out.failure = "start pose is not alongside the road lanes";
+    return out;
+  }
+  const double yaw_dev = normalize_angle(start.yaw - center.yaw_at(s_start));
+  if (std::abs(yaw_dev) > kMaxStartYawDeviation) {
+    out.failure = "start heading deviates " + format_fixed(yaw_dev * 180.0 / M_PI, 1) + " deg from the road (limit " +
+                  format_fixed(kMaxStartYawDeviation * 180.0 / M_PI, 0) + ")";
+    return out;
+  }
+  const RoadEnd end = find_path_end(ctx, s_start);
+  const double v_road = speed_limit_at(ctx, s_start);
+
+  std::vector<ShiftKinematics> kinematics;
+  if (std::abs(shift_length) < kMinShiftLength) {
+    // Already on the centerline: drive straight on, accelerating towards the speed limit.
+    ShiftKinematics straight;
+    straight.longitudinal_acc = params.maximum_longitudinal_acc;
+    straight.terminal_velocity = v_road;
+    kinematics.push_back(straight);
+  } else {
+    for (double a_lat : lateral_acc_samples(params)) {
+      kinematics.push_back(compute_shift_kinematics(shift_length, a_lat, v_road, params));
+    }
+  }
+
+  // Lane departure is checked unless disabled, or (override) unless the vehicle already stands
+  // partly outside the lanes.
+  bool check_lanes = params.check_shift_path_lane_departure;
+  if (check_lanes && params.allow_check_shift_path_lane_departure_override) {
+    check_lanes = !first_lane_departure(ctx, {start}, 0, 0, params.lane_departure_check_expansion_margin).has_value();
+  }
+
+  for (const ShiftKinematics& k : kinematics) {
+    if (deadline.expired()) {
+      out.timed_out = true;
+      break;
+    }
+    PathCandidate candidate;
+    double length = k.distance;
+    std::optional<ShiftShape> shape;
+    if (k.distance > 0.0) {
+      // Centerline length whose shifted section is k.distance long (differs on curves).
+      for (int iter = 0; iter < 2; ++iter) {
+        const ShiftShape trial(k.profile, shift_length, s_start, length);
+        length *= k.distance / shifted_length(center, trial, s_start, length);
+      }
+      const double s_end = push_end_to_low_curvature(center, s_start + length, params.end_pose_curvature_threshold);
+      if (s_end > end.s - 1e-6) {
+        candidate.rejection = end.is_goal ? "goal too close for the shift" : "road lanes too short for the shift";
+        out.candidates.push_back(std::move(candidate));
+        continue;
+      }
+      shape.emplace(k.profile, shift_length, s_start, s_end - s_start);
+    } else {
+      shape.emplace(k.profile, 0.0, s_start, 0.0);
+    }
+    // Collision section: from the start to end_pose + shift_collision_check_distance_from_end.
+    const double s_check_end = shape->end() + params.shift_collision_check_distance_from_end;
+    auto c = std::make_shared<Candidate>(sample_poses(ctx, *shape, s_start, end, std::max(shape->end(), s_check_end)));
+    std::size_t section_last = 0;
+    while (section_last + 1 < c->s.size() && c->s[section_last + 1] <= s_check_end) ++section_last;
+    check_candidate(ctx, c->poses,
+                    {check_lanes, params.lane_departure_check_expansion_margin, c->shift_end_index, section_last,
+                     std::max(section_last, c->shift_end_index)},
+                    candidate);
+    candidate.build = [&ctx, c, end, k, shift_length]() {
+      extend_poses(ctx, *c);
+      PullOutPath path;
+      path.start_pose = c->poses.front();
+      path.end_pose = c->poses[c->shift_end_index];
+      path.shift_length_m = std::abs(shift_length) < kMinShiftLength ? 0.0 : shift_length;
+      path.partial_paths.push_back(to_path(ctx, *c, end, k.terminal_velocity));
+      path.pairs_terminal_velocity_and_accel.push_back({k.terminal_velocity, k.longitudinal_acc});
+      return path;
+    };
+    out.candidates.push_back(std::move(candidate));
+  }
+  return out;
+}
+
+}  // namespace pullout

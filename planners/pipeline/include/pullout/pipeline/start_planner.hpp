@@ -1,0 +1,95 @@
+// The start planner pipeline: validate a request, build the world, search the planners over the
+// collision-margin ladder, and return a path (or a stop path with every attempt's reason).
+//
+//   request -> validate -> world (lanes, static objects) -> for each margin in
+//   collision_check_margins: for each planner in search_priority: plan, check lane departure and
+//   static collision -> first success -> velocities -> PullOutPath. Nothing found and
+//   freespace_planner.enable_freespace_planner: the freespace pull-out (hybrid A*) from the ego
+//   pose. A request with an occupancy grid and no lanes (allowed when the freespace planner is
+//   enabled) is a pure freespace problem: hybrid A* straight to the goal pose.
+//
+// Thread safety: StartPlanner is immutable after construction; plan() may be called concurrently
+// from several threads. Failure modes are values, never exceptions: an invalid request gives
+// Outcome::kRejected with one issue per problem (naming the field), "no path" gives
+// Outcome::kNoPath with a stop path and the reasons, and an expired deadline gives kNoPath with
+// timed_out = true.
+//
+// Lanes come either inline (request.lanes) or from the Lanelet2 map given at construction:
+// request.route_lanelet_ids then names the road lanelets to pull out onto, and the pipeline plans
+// on the lanes select_map_lanes (maps/map_lanes.hpp) picks around the vehicle. A request with
+// route ids and no map, or with both lanes and route ids, is rejected.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pullout/model/types.hpp"
+#include "pullout/pipeline/parameters.hpp"
+#include "pullout/pipeline/published_path.hpp"
+#include "pullout/search/deadline.hpp"
+#include "pullout/vehicle/vehicle_info.hpp"
+
+namespace pullout {
+
+class LaneletMap;
+
+// "field: problem" lines joined by '\n'.
+std::string format_issues(const std::vector<RequestIssue>& issues);
+
+// The world a search planned on: the lanes (the request's inline lanes, or those picked on the map
+// for its route) and the request's objects. The safety checks of a found path use exactly these.
+struct PlannedWorld {
+  std::vector<Lane> lanes;
+  std::vector<Object> objects;
+};
+
+struct PlanningResult {
+  enum class Outcome { kFound, kNoPath, kRejected };
+  Outcome outcome{Outcome::kNoPath};
+  // kFound: the path. kNoPath: a stop path at the ego pose (all velocities 0, found = false,
+  // reasons filled). kRejected: empty.
+  PullOutPath path;
+  std::vector<PlannerAttempt> evaluation_table;  // one row per attempt, in search order
+  std::string stop_reason;                       // kNoPath: one line summary
+  std::vector<RequestIssue> issues;              // kRejected
+  // kFound: how the published path ends (finish_published_path): where it stops before an object
+  // beyond the end pose, or that it is clear; `path_end.note` is also the last of path.reasons.
+  PublishedPathEnd path_end;
+  bool timed_out{false};
+  double planning_time_ms{0.0};
+  // kFound and kNoPath: what was planned on (lanes empty for a grid-only request). Null: kRejected.
+  std::shared_ptr<const PlannedWorld> world;
+};
+
+class StartPlanner {
+ public:
+  // Parameters must be valid (as load_config / check_config accept them). `map` may be null (no
+  // map: only inline lanes are accepted).
+  StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits = {},
+               std::shared_ptr<const LaneletMap> map = nullptr);
+
+  // Plans for one request. Applies the request's overrides (search_priority, search_policy) to
+  // a copy of the parameters. Never throws for bad input.
+  PlanningResult plan(const PullOutRequest& request, const Deadline& deadline) const;
+
+  // Only the validation step of plan(): every problem of the request, empty when valid.
+  std::vector<RequestIssue> validate(const PullOutRequest& request) const;
+
+  const VehicleInfo& vehicle() const { return vehicle_; }
+  const StartPlannerParameters& parameters() const { return parameters_; }
+  const RequestLimits& limits() const { return limits_; }
+  const std::shared_ptr<const LaneletMap>& map() const { return map_; }
+
+ private:
+  bool grid_only_allowed() const;
+  // A request with a grid and no lanes: hybrid A* straight to the goal pose.
+  PlanningResult plan_grid_only(const PullOutRequest& request, const Deadline& deadline) const;
+
+  VehicleInfo vehicle_;
+  StartPlannerParameters parameters_;
+  RequestLimits limits_;
+  std::shared_ptr<const LaneletMap> map_;
+};
+
+}  // namespace pullout

@@ -1,0 +1,432 @@
+#include "pullout/pipeline/start_planner.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "pullout/collision/footprint.hpp"
+#include "pullout/collision/object_checker.hpp"
+#include "pullout/freespace/freespace_pull_out.hpp"
+#include "pullout/lane_planners/clothoid_pull_out.hpp"
+#include "pullout/lane_planners/geometric_pull_out.hpp"
+#include "pullout/lane_planners/shift_pull_out.hpp"
+#include "pullout/lanes/lane_world.hpp"
+#include "pullout/maps/lanelet_map.hpp"
+#include "pullout/maps/map_lanes.hpp"
+#include "pullout/model/names.hpp"
+#include "start_candidates.hpp"
+#include "validation.hpp"
+
+namespace pullout {
+
+namespace {
+
+// [m] Road kept behind the start beyond max_back_distance (Autoware's backward_path_length).
+constexpr double kBackwardPathLength = 5.0;
+// [m] A route passing farther than this from the start is not the one to pull out onto.
+constexpr double kMaxRouteDistance = 10.0;
+
+// The lanes one request plans on: its inline lanes, or those picked on the map for its route
+// (with the road and pull-out lanes in driving order).
+struct RequestLanes {
+  std::vector<Lane> from_map;
+  const std::vector<Lane>* lanes{nullptr};
+  std::vector<std::int64_t> road_ids;      // map requests: the road lanes
+  std::vector<std::int64_t> pull_out_ids;  // map requests: the shoulder lanes (empty: the road)
+  std::vector<RequestIssue> issues;
+};
+
+RequestLanes request_lanes(const PullOutRequest& request, const LaneletMap* map, const VehicleInfo& vehicle,
+                           const StartPlannerParameters& params) {
+  RequestLanes out;
+  if (request.route_lanelet_ids.empty() || map == nullptr) {
+    out.lanes = &request.lanes;
+    return out;
+  }
+  MapLaneOptions options;
+  options.backward_length_m = kBackwardPathLength + params.max_back_distance;
+  options.forward_length_m = params.forward_path_length;
+  options.start_tolerance_m = vehicle.width_m() / 2.0;
+  options.max_route_distance_m = kMaxRouteDistance;
+  MapLanes selected = select_map_lanes(*map, request, options);
+  out.issues = std::move(selected.issues);
+  out.from_map = std::move(selected.lanes);
+  out.lanes = &out.from_map;
+  out.road_ids = std::move(selected.road_ids);
+  out.pull_out_ids = std::move(selected.pull_out_ids);
+  return out;
+}
+
+std::vector<std::size_t> indices_of(const LaneWorld& world, const std::vector<std::int64_t>& ids) {
+  std::vector<std::size_t> out;
+  for (std::int64_t id : ids) {
+    if (const auto i = world.find(id)) out.push_back(*i);
+  }
+  return out;
+}
+
+const std::vector<PlannerType>& available_planners() {
+  static const std::vector<PlannerType> kAvailable(kSearchPlanners.begin(), kSearchPlanners.end());
+  return kAvailable;
+}
+
+std::unique_ptr<PullOutPlanner> make_planner(PlannerType type, const StartPlannerParameters& parameters) {
+  switch (type) {
+    case PlannerType::kShift:
+      return std::make_unique<ShiftPullOut>();
+    case PlannerType::kGeometric:
+      return std::make_unique<GeometricPullOut>();
+    case PlannerType::kClothoid:
+      return std::make_unique<ClothoidPullOut>();
+    case PlannerType::kFreespace:
+      return std::make_unique<FreespacePullOut>(parameters.freespace_planner);
+    default:
+      return nullptr;
+  }
+}
+
+std::string format_margin(double m) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(2);
+  os << m;
+  return os.str();
+}
+
+// The start pose must lie on a lane; a vehicle half a width outside still counts (it may stand
+// partly on the kerb), further away it is not on this request's lanes at all.
+std::optional<RequestIssue> check_start_on_lanes(const LaneWorld& world, const Pose2& ego, const VehicleInfo& v) {
+  const Vec2 p = to_vec(ego);
+  if (world.contains(p)) return std::nullopt;
+  double nearest = std::numeric_limits<double>::infinity();
+  std::int64_t nearest_id = 0;
+  for (const LaneGeometry& lane : world.lanes()) {
+    const Polygon& poly = lane.polygon;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const double d = distance_to_segment(p, poly[i], poly[(i + 1) % poly.size()]);
+      if (d < nearest) {
+        nearest = d;
+        nearest_id = lane.id;
+      }
+    }
+  }
+  if (nearest <= v.width_m() / 2.0) return std::nullopt;
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(2);
+  os << "(" << ego.x << ", " << ego.y << ") is on no lane; the nearest, lane " << nearest_id << ", is " << nearest
+     << " m away";
+  return RequestIssue{"ego_pose", os.str()};
+}
+
+PullOutPath make_stop_path(const PullOutRequest& request) {
+  PullOutPath path;
+  path.found = false;
+  path.planner_type = PlannerType::kStop;
+  PathWithLaneId stop;
+  PathPoint point;
+  point.pose = request.ego_pose;
+  point.longitudinal_velocity_mps = 0.0;
+  stop.points = {point, point};
+  path.partial_paths.push_back(std::move(stop));
+  path.pairs_terminal_velocity_and_accel.push_back({0.0, 0.0});
+  path.start_pose = request.ego_pose;
+  path.end_pose = request.ego_pose;
+  return path;
+}
+
+// One line per planner: the outcomes at the last margin tried (the least demanding one).
+std::vector<std::string> no_path_reasons(const std::vector<PlannerAttempt>& attempts) {
+  std::vector<std::string> reasons;
+  if (attempts.empty()) return reasons;
+  const double last_margin = attempts.back().margin_m;
+  for (const PlannerAttempt& a : attempts) {
+    if (a.planner == PlannerType::kNone || a.margin_m != last_margin) continue;
+    reasons.push_back(std::string(to_string(a.planner)) + " at margin " + format_margin(a.margin_m) + " m, backward " +
+                      format_margin(a.backward_distance_m) + " m: " + a.outcome);
+  }
+  return reasons;
+}
+
+// Every published point checked against the static objects; the path stops before the first one
+// beyond the end pose (published_path.hpp), and says how it ends.
+void publish_checked(PlanningResult& result, const ObjectChecker& objects, double margin,
+                     const StartPlannerParameters& params) {
+  const PublishedPathLimits limits{margin, params.stop_condition.maximum_deceleration_for_stop,
+                                   params.stop_condition.maximum_jerk_for_stop};
+  result.path_end = finish_published_path(result.path, objects, limits);
+  if (!result.path_end.note.empty()) result.path.reasons.push_back(result.path_end.note);
+}
+
+// The static objects of a grid-only request, for the final check of its path.
+ObjectChecker static_obstacle_checker(const PullOutRequest& request, const VehicleInfo& vehicle,
+                                      const StartPlannerParameters& params) {
+  std::vector<Obstacle> obstacles;
+  for (const Object& o : request.objects) {
+    if (std::abs(o.velocity_mps) >= params.th_moving_object_velocity) continue;
+    if (!params.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
+    obstacles.push_back({o.id, object_polygon(o)});
+  }
+  return ObjectChecker(vehicle_footprint(vehicle), std::move(obstacles));
+}
+
+}  // namespace
+
+bool planner_available(PlannerType type) {
+  const auto& a = available_planners();
+  return std::find(a.begin(), a.end(), type) != a.end();
+}
+
+StartPlanner::StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits,
+                           std::shared_ptr<const LaneletMap> map)
+    : vehicle_(vehicle), parameters_(std::move(parameters)), limits_(limits), map_(std::move(map)) {}
+
+std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) const {
+  auto issues =
+      validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
+  if (!issues.empty() || (request.lanes.empty() && request.route_lanelet_ids.empty())) return issues;
+  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_);
+  if (!lanes.issues.empty()) return lanes.issues;
+  const LaneWorld world(*lanes.lanes);
+  if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) issues.push_back(*issue);
+  return issues;
+}
+
+bool StartPlanner::grid_only_allowed() const { return parameters_.freespace_planner.enable_freespace_planner; }
+
+PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const Deadline& deadline) const {
+  PlanningResult result;
+  const FreespaceParameters& p = parameters_.freespace_planner;
+  std::vector<Polygon> obstacles;
+  for (const Object& o : request.objects) {
+    if (std::abs(o.velocity_mps) >= parameters_.th_moving_object_velocity) continue;
+    if (!parameters_.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
+    obstacles.push_back(object_polygon(o));
+  }
+  const Costmap costmap = freespace_costmap(p, &*request.occupancy_grid, nullptr, obstacles, request.ego_pose, 0.0);
+  FreespaceGoalResult r = plan_freespace_to_goal(costmap, vehicle_, p, request.ego_pose, request.goal_pose, deadline);
+  const double margin = 0.5 * p.vehicle_shape_margin;
+  result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, to_string(r.status)});
+  if (r.status == HybridAStarResult::Status::kSuccess) {
+    result.outcome = PlanningResult::Outcome::kFound;
+    result.path = std::move(r.path);
+    publish_checked(result, static_obstacle_checker(request, vehicle_, parameters_), margin, parameters_);
+    return result;
+  }
+  result.timed_out = r.status == HybridAStarResult::Status::kTimeout;
+  result.outcome = PlanningResult::Outcome::kNoPath;
+  result.path = make_stop_path(request);
+  result.stop_reason = std::string("freespace to the goal: ") + to_string(r.status);
+  result.path.reasons.push_back(result.stop_reason);
+  return result;
+}
+
+PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline& deadline) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  PlanningResult result;
+  const std::vector<Lane>* planned_lanes = nullptr;  // the lanes planned on, once known
+  const auto finish = [&](PlanningResult& r) {
+    if (r.outcome != PlanningResult::Outcome::kRejected) {
+      r.world = std::make_shared<const PlannedWorld>(
+          PlannedWorld{planned_lanes != nullptr ? *planned_lanes : std::vector<Lane>{}, request.objects});
+    }
+    r.planning_time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    r.path.vehicle_id = request.vehicle_id;
+    r.path.request_id = request.request_id;
+    r.path.stamp_ns = request.stamp_ns;
+  };
+
+  result.issues =
+      validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
+  if (!result.issues.empty()) {
+    result.outcome = PlanningResult::Outcome::kRejected;
+    finish(result);
+    return result;
+  }
+  if (request.lanes.empty() && request.route_lanelet_ids.empty()) {  // validation allowed it: a grid and freespace
+    result = plan_grid_only(request, deadline);
+    finish(result);
+    return result;
+  }
+  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_);
+  if (!lanes.issues.empty()) {
+    result.issues = lanes.issues;
+    result.outcome = PlanningResult::Outcome::kRejected;
+    finish(result);
+    return result;
+  }
+  planned_lanes = lanes.lanes;
+  const LaneWorld world(*lanes.lanes);
+  if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) {
+    result.issues.push_back(*issue);
+    result.outcome = PlanningResult::Outcome::kRejected;
+    finish(result);
+    return result;
+  }
+
+  StartPlannerParameters params = parameters_;
+  if (!request.overrides.search_priority.empty()) params.search_priority = request.overrides.search_priority;
+  if (request.overrides.search_policy) params.search_policy = *request.overrides.search_policy;
+
+  // The road lanes to pull out onto: the map's pick for the route, or the chain through the road
+  // lane nearest to the vehicle.
+  const bool from_map = !lanes.road_ids.empty();
+  const LaneChain road = from_map
+                             ? world.chain_of(indices_of(world, lanes.road_ids))
+                             : world.chain_through(*world.nearest_lane(to_vec(request.ego_pose), LaneSubtype::kRoad));
+
+  // Static obstacles: objects slower than th_moving_object_velocity, of the classes to check.
+  // All of them are considered, wherever they stand (Autoware keeps only those overlapping the
+  // pull-out lanes, which misses a car standing half on the kerb next to the path).
+  std::vector<Obstacle> obstacles;
+  std::vector<Polygon> obstacle_polygons;
+  for (const Object& o : request.objects) {
+    if (std::abs(o.velocity_mps) >= params.th_moving_object_velocity) continue;
+    if (!params.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
+    obstacles.push_back({o.id, object_polygon(o)});
+    obstacle_polygons.push_back(obstacles.back().polygon);
+  }
+  const ObjectChecker checker(vehicle_footprint(vehicle_), std::move(obstacles));
+  // The lanes the vehicle stands in: the shoulder chain when it is on a shoulder, else the road.
+  LaneChain shoulder;
+  const LaneChain* pull_out = &road;
+  if (from_map) {
+    if (!lanes.pull_out_ids.empty()) {
+      shoulder = world.chain_of(indices_of(world, lanes.pull_out_ids));
+      pull_out = &shoulder;
+    }
+  } else {
+    for (std::size_t i : world.lanes_containing(to_vec(request.ego_pose))) {
+      if (world.lanes()[i].subtype == LaneSubtype::kRoadShoulder) {
+        shoulder = world.chain_through(i);
+        pull_out = &shoulder;
+        break;
+      }
+    }
+  }
+  double horizon = 0.0;
+  for (double m : params.collision_check_margins) horizon = std::max(horizon, m);
+  const PlanningContext context{world,
+                                road,
+                                *pull_out,
+                                checker,
+                                vehicle_,
+                                params,
+                                request.goal_pose,
+                                horizon,
+                                request.ego_pose,
+                                request.occupancy_grid ? &*request.occupancy_grid : nullptr,
+                                &obstacle_polygons};
+
+  std::vector<std::unique_ptr<PullOutPlanner>> planners;
+  for (PlannerType t : params.search_priority) {
+    if (auto p = make_planner(t, params)) planners.push_back(std::move(p));
+  }
+  // Start candidates: the current pose, then poses behind it (enable_back).
+  const StartCandidateSearch search = search_start_candidates(context, params, request.ego_pose);
+  const std::vector<StartCandidate>& starts = search.candidates;
+  for (const auto& skipped : search.skipped) {
+    result.evaluation_table.push_back({PlannerType::kNone, 0.0, skipped.backward_distance, skipped.reason});
+  }
+  // The order of (candidate, planner) pairs inside one margin, per search_policy.
+  std::vector<std::pair<std::size_t, std::size_t>> order;
+  if (params.search_policy == SearchPolicy::kPlannerPriority) {
+    for (std::size_t p = 0; p < planners.size(); ++p) {
+      for (std::size_t c = 0; c < starts.size(); ++c) order.emplace_back(c, p);
+    }
+  } else {
+    for (std::size_t c = 0; c < starts.size(); ++c) {
+      for (std::size_t p = 0; p < planners.size(); ++p) order.emplace_back(c, p);
+    }
+  }
+
+  const auto accept = [&](const PathCandidate& chosen, PlannerType type) {
+    result.outcome = PlanningResult::Outcome::kFound;
+    result.path = chosen.build();
+    result.path.found = true;
+    result.path.planner_type = type;
+    // The vehicle moves towards the centerline: right when it starts left of it.
+    result.path.turn_signal = result.path.shift_length_m > 0.0   ? TurnSignal::kRight
+                              : result.path.shift_length_m < 0.0 ? TurnSignal::kLeft
+                                                                 : TurnSignal::kNone;
+  };
+
+  // Each (start, planner) pair is planned once, on first use; the margin ladder only re-reads
+  // the candidates' clearances.
+  std::vector<std::optional<PlannerCandidates>> planned(starts.size() * planners.size());
+  for (double margin : params.collision_check_margins) {
+    for (const auto& [ci, pi] : order) {
+      if (deadline.expired()) {
+        result.timed_out = true;
+        break;
+      }
+      const StartCandidate& start = starts[ci];
+      auto& slot = planned[ci * planners.size() + pi];
+      if (!slot) slot = planners[pi]->plan(context, start.pose, deadline);
+      result.timed_out = result.timed_out || slot->timed_out;
+      const Selection sel = select_candidate(*slot, margin);
+      result.evaluation_table.push_back({planners[pi]->type(), margin, start.backward_distance, sel.outcome});
+      if (sel.chosen != nullptr) {
+        accept(*sel.chosen, planners[pi]->type());
+        if (start.backward_distance > 0.0) {
+          // Reverse to the start candidate first. Pair: cruise at backward_velocity, reached
+          // over half the segment (a = v^2 / L) so that the vehicle stops at its end.
+          const double v = params.backward_velocity;
+          result.path.partial_paths.insert(result.path.partial_paths.begin(),
+                                           reverse_segment(context, params, request.ego_pose, start));
+          result.path.pairs_terminal_velocity_and_accel.insert(result.path.pairs_terminal_velocity_and_accel.begin(),
+                                                               {v, -v * v / start.backward_distance});
+        }
+        publish_checked(result, checker, margin, params);
+        finish(result);
+        return result;
+      }
+    }
+    if (result.timed_out) break;
+  }
+
+  // Nothing found: the freespace fallback (unless it was searched in the order already).
+  const bool freespace_listed = std::find(params.search_priority.begin(), params.search_priority.end(),
+                                          PlannerType::kFreespace) != params.search_priority.end();
+  if (params.freespace_planner.enable_freespace_planner && !freespace_listed && !result.timed_out) {
+    const PlannerCandidates fallback =
+        FreespacePullOut(params.freespace_planner).plan(context, request.ego_pose, deadline);
+    result.timed_out = fallback.timed_out;
+    // The costmap keeps the grown footprint off every object: the margin is half the growth.
+    const double margin = 0.5 * params.freespace_planner.vehicle_shape_margin;
+    const Selection sel = select_candidate(fallback, 1e-6);  // any clearance: no contact
+    result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, sel.outcome});
+    if (sel.chosen != nullptr) {
+      accept(*sel.chosen, PlannerType::kFreespace);
+      publish_checked(result, checker, margin, params);
+      finish(result);
+      return result;
+    }
+  }
+
+  result.outcome = PlanningResult::Outcome::kNoPath;
+  result.path = make_stop_path(request);
+  result.path.reasons = no_path_reasons(result.evaluation_table);
+  if (result.timed_out) {
+    std::ostringstream os;
+    os << "planning deadline exceeded after " << result.evaluation_table.size() << " attempts";
+    result.stop_reason = os.str();
+    result.path.reasons.push_back(result.stop_reason);
+  } else if (planners.empty()) {
+    result.stop_reason = "no planner enabled";
+    result.path.reasons.push_back(result.stop_reason);
+  } else if (starts.empty()) {
+    result.stop_reason = "no start pose candidate: boxed in";
+    for (const auto& skipped : search.skipped) {
+      result.path.reasons.push_back(skipped.reason + " (" + format_margin(skipped.backward_distance) + " m back)");
+    }
+  } else {
+    result.stop_reason = "no safe path at any collision margin";
+  }
+  finish(result);
+  return result;
+}
+
+}  // namespace pullout
