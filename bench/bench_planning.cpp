@@ -22,7 +22,7 @@ void plan_scenario(benchmark::State& state, const std::string& name) {
   const pullout::StartPlanner planner(scenario.vehicle, scenario.parameters);
   std::size_t attempts = 0;
   for (auto _ : state) {
-    const pullout::PlanningResult r = planner.plan(scenario.request, pullout::Deadline());
+    const pullout::PlanningResult r = planner.plan(scenario.request, pullout::StopCondition());
     attempts = r.evaluation_table.size();
     benchmark::DoNotOptimize(r.path.partial_paths.data());
   }

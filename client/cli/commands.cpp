@@ -14,7 +14,7 @@
 #include "pullout/config/scenario.hpp"
 #include "pullout/maps/lanelet_map.hpp"
 #include "pullout/model/names.hpp"
-#include "pullout/pipeline/deadline.hpp"
+#include "pullout/search/stop_condition.hpp"
 #include "pullout/pipeline/parameters.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "report.hpp"
@@ -115,7 +115,7 @@ int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
   // The service's budget rule: the request's deadline, else the configured default.
   const double budget_ms =
       scenario.request.deadline_ms > 0.0 ? scenario.request.deadline_ms : config.service.default_deadline_ms;
-  const PlanningResult result = planner.plan(scenario.request, Deadline::after_ms(budget_ms));
+  const PlanningResult result = planner.plan(scenario.request, StopCondition::after_ms(budget_ms));
   return emit(make_report(result), scenario, options.scenario_file, options.output, out, err);
 }
 

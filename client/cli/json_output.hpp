@@ -14,8 +14,11 @@
 //                   "length": 40.1}],          // [m/s], [m/s^2], [m]
 //     "start_pose": {"x": 0.0, "y": 0.0, "yaw": 0.0},   // [m], [rad]; null without a path
 //     "end_pose":   {"x": 0.0, "y": 0.0, "yaw": 0.0},
-//     "evaluation_table": [{"planner": "shift", "margin": 2.0, "backward_distance": 0.0,
-//                           "outcome": "collision"}],   // [m]
+//     "evaluation_table": [{"planner": "shift", "margin": 2.0, "backward_distance": 0.0,   // [m]
+//                           "outcome": "collision",     // success | collision | lane_departure |
+//                           // no_geometry | start_invalid | goal_invalid | timeout | cancelled |
+//                           // node_limit | no_path
+//                           "detail": "object 7 (4/4 candidates)"}],   // "" when none
 //     "planning_time_ms": 3.2,
 //     "reasons": ["..."],                      // why nothing was found; [] when found
 //     "error": ""                              // rejected: "<field>: <problem>" lines

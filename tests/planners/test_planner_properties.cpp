@@ -38,7 +38,7 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
   StartPlannerParameters params = sc.parameters;
   params.search_priority = {planner_type};
   const StartPlanner planner(sc.vehicle, params);
-  const PlanningResult r = planner.plan(sc.request, Deadline());
+  const PlanningResult r = planner.plan(sc.request, StopCondition());
   if (r.outcome != PlanningResult::Outcome::kFound) {
     // Not finding a path is allowed; it must come as a stop path with reasons.
     EXPECT_FALSE(r.path.found);
@@ -53,7 +53,7 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
   ASSERT_GE(path.partial_paths.size(), 1u);
   ASSERT_EQ(path.pairs_terminal_velocity_and_accel.size(), path.partial_paths.size()) << "one pair per segment";
   const double margin = r.evaluation_table.back().margin_m;
-  ASSERT_EQ(r.evaluation_table.back().outcome, "success");
+  ASSERT_EQ(r.evaluation_table.back().outcome, AttemptOutcome::kSuccess);
 
   // Starts at the vehicle.
   EXPECT_NEAR(path.partial_paths[0].points[0].pose.x, sc.request.ego_pose.x, 1e-9);
@@ -161,7 +161,7 @@ class ScenarioExpectations : public ::testing::TestWithParam<const char*> {};
 TEST_P(ScenarioExpectations, MatchTheFile) {
   const Scenario sc = load(GetParam());
   const StartPlanner planner(sc.vehicle, sc.parameters, {}, sc.map);
-  const PlanningResult r = planner.plan(sc.request, Deadline());
+  const PlanningResult r = planner.plan(sc.request, StopCondition());
   ASSERT_TRUE(sc.expect.found.has_value()) << "every bundled scenario states whether a path exists";
   EXPECT_EQ(r.path.found, *sc.expect.found) << r.stop_reason;
   if (sc.expect.planner) {
@@ -184,7 +184,7 @@ INSTANTIATE_TEST_SUITE_P(Bundled, ScenarioExpectations, ::testing::ValuesIn(kExp
 
 TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {
   const Scenario sc = load("car_close_ahead");
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
   ASSERT_TRUE(r.path.found);
   ASSERT_GE(r.path.partial_paths.size(), 2u);
   EXPECT_LT(direction_of(r.path.partial_paths[0]), 0.0);
@@ -196,7 +196,7 @@ TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {
 
 TEST(ScenarioSpecifics, ParallelSpotStopsBetweenTheArcsWithConsistentPairs) {
   const Scenario sc = load("parallel_spot");
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
   ASSERT_TRUE(r.path.found);
   ASSERT_EQ(r.path.planner_type, PlannerType::kGeometric);
   ASSERT_EQ(r.path.partial_paths.size(), 2u);  // divide_pull_out_path: true
@@ -212,7 +212,7 @@ TEST(ScenarioSpecifics, ParallelSpotStopsBetweenTheArcsWithConsistentPairs) {
 
   StartPlannerParameters single = sc.parameters;
   single.divide_pull_out_path = false;
-  const PlanningResult r1 = StartPlanner(sc.vehicle, single).plan(sc.request, Deadline());
+  const PlanningResult r1 = StartPlanner(sc.vehicle, single).plan(sc.request, StopCondition());
   ASSERT_TRUE(r1.path.found);
   EXPECT_EQ(r1.path.partial_paths.size(), 1u);
 }
