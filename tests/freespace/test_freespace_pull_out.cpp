@@ -202,8 +202,9 @@ TEST(FreespacePullOut, CancelledFlagStopsThePullOutSearch) {
     polygons.push_back(obstacles.back().polygon);
   }
   const ObjectChecker checker(vehicle_footprint(sc.vehicle), obstacles);
-  const PlanningContext ctx{world,    road,          road, checker, sc.vehicle, sc.parameters, sc.request.goal_pose,
-                            2.0,      sc.request.ego_pose, nullptr, &polygons};
+  const PlanningContext ctx{
+      world,   road,     road, checker, sc.vehicle, sc.parameters, sc.request.goal_pose, 2.0, sc.request.ego_pose,
+      nullptr, &polygons};
   std::atomic<bool> cancel{false};
   const StopCondition stop = StopCondition().with_cancel(&cancel);
   const PlannerCandidates running = FreespacePullOut().plan(ctx, sc.request.ego_pose, stop);

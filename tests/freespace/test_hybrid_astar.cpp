@@ -134,7 +134,8 @@ TEST(HybridAStar, TypedFailures) {
   EXPECT_EQ(planner.plan({14, 10, 0}, {25, 10, 0}, StopCondition()).status, HybridAStarResult::Status::kStartOccupied);
   EXPECT_EQ(planner.plan({5, 10, 0}, {14.5, 20, 0}, StopCondition()).status, HybridAStarResult::Status::kGoalOccupied);
   EXPECT_EQ(planner.plan({5, 10, 0}, {-50, 10, 0}, StopCondition()).status, HybridAStarResult::Status::kGoalOccupied);
-  EXPECT_EQ(planner.plan({5, 10, 0}, {25, 10, 0}, StopCondition::after_ms(5000)).status, HybridAStarResult::Status::kNoPath);
+  EXPECT_EQ(planner.plan({5, 10, 0}, {25, 10, 0}, StopCondition::after_ms(5000)).status,
+            HybridAStarResult::Status::kNoPath);
 }
 
 TEST(HybridAStar, DeadlineGivesATimeoutPromptly) {
@@ -150,7 +151,8 @@ TEST(HybridAStar, DeadlineGivesATimeoutPromptly) {
   // The deadline plus the fixed set-up (heuristic grid) and one check interval; generous for a
   // loaded 2-core CI machine.
   EXPECT_LT(ms, 100.0);
-  EXPECT_EQ(planner.plan({10, 10, 0}, {90, 90, 0}, StopCondition::after_ms(0)).status, HybridAStarResult::Status::kTimeout);
+  EXPECT_EQ(planner.plan({10, 10, 0}, {90, 90, 0}, StopCondition::after_ms(0)).status,
+            HybridAStarResult::Status::kTimeout);
 }
 
 }  // namespace

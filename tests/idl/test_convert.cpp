@@ -403,7 +403,7 @@ TEST(Convert, StatusRoundTrip) {
 }
 
 TEST(Convert, EveryAttemptOutcomeRoundTrips) {
-  const AttemptOutcome all[] = {AttemptOutcome::kSuccess,      AttemptOutcome::kCollision,
+  const AttemptOutcome all[] = {AttemptOutcome::kSuccess,       AttemptOutcome::kCollision,
                                 AttemptOutcome::kLaneDeparture, AttemptOutcome::kNoGeometry,
                                 AttemptOutcome::kStartInvalid,  AttemptOutcome::kGoalInvalid,
                                 AttemptOutcome::kTimeout,       AttemptOutcome::kCancelled,

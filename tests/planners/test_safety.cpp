@@ -5,11 +5,11 @@
 #include <cmath>
 
 #include "pullout/config/scenario.hpp"
-#include "pullout/search/stop_condition.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "pullout/safety/rss_check.hpp"
 #include "pullout/safety/safety_monitor.hpp"
 #include "pullout/safety/stop_path.hpp"
+#include "pullout/search/stop_condition.hpp"
 #include "test_world.hpp"
 
 namespace pullout {

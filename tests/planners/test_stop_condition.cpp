@@ -86,8 +86,8 @@ TEST(StopCondition, ASecondCancelFlagIsAProgrammingError) {
   std::atomic<bool> a{false};
   std::atomic<bool> b{false};
   const StopCondition stop = StopCondition().with_cancel(&a);
-  EXPECT_NO_THROW(stop.with_cancel(&a));        // the same flag again
-  EXPECT_NO_THROW(stop.with_cancel(nullptr));   // nothing added
+  EXPECT_NO_THROW(stop.with_cancel(&a));       // the same flag again
+  EXPECT_NO_THROW(stop.with_cancel(nullptr));  // nothing added
   EXPECT_THROW(stop.with_cancel(&b), std::logic_error);
 }
 

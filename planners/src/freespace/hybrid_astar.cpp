@@ -14,13 +14,13 @@ namespace fd = freespace_detail;
 namespace {
 
 constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
-constexpr std::size_t kStopCheckInterval = 16;  // expansions between checks of the stop condition
-constexpr int kShotCandidates = 3;                  // Reeds-Shepp words tried per shot, cheapest first
-constexpr double kShotDistancePerInterval = 4.0;    // [m] heuristic distance per expansion between shots
-constexpr double kReedsSheppRange = 4.0;            // [turning radii] see heuristic()
-constexpr double kCoarseSpacing = 1.0;              // [m] first-pass sample spacing of a shot
-constexpr double kSweepGrowth = 0.5;                // [cells] footprint growth between tested poses
-constexpr double kFineSweepGrowth = 0.125;          // [cells] the same where kSweepGrowth refuses
+constexpr std::size_t kStopCheckInterval = 16;    // expansions between checks of the stop condition
+constexpr int kShotCandidates = 3;                // Reeds-Shepp words tried per shot, cheapest first
+constexpr double kShotDistancePerInterval = 4.0;  // [m] heuristic distance per expansion between shots
+constexpr double kReedsSheppRange = 4.0;          // [turning radii] see heuristic()
+constexpr double kCoarseSpacing = 1.0;            // [m] first-pass sample spacing of a shot
+constexpr double kSweepGrowth = 0.5;              // [cells] footprint growth between tested poses
+constexpr double kFineSweepGrowth = 0.125;        // [cells] the same where kSweepGrowth refuses
 
 double wrap(double a) {
   a = std::fmod(a + kTwoPi / 2.0, kTwoPi);
@@ -354,8 +354,8 @@ HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const
   if (const StopReason reason = stop.check(); reason != StopReason::kNone) {
     HybridAStarResult result;
     result.stopped = reason;
-    result.status = reason == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
-                                                     : HybridAStarResult::Status::kTimeout;
+    result.status =
+        reason == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled : HybridAStarResult::Status::kTimeout;
     return result;
   }
   Search search(checker_, config_, start, goal);

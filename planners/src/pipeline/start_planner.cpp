@@ -187,8 +187,8 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
   const Costmap costmap = freespace_costmap(p, &*request.occupancy_grid, nullptr, obstacles, request.ego_pose, 0.0);
   FreespaceGoalResult r = plan_freespace_to_goal(costmap, vehicle_, p, request.ego_pose, request.goal_pose, stop);
   const double margin = 0.5 * p.vehicle_shape_margin;
-  const Failure f = r.stopped != StopReason::kNone ? stopped_failure(r.stopped)
-                                                   : Failure{attempt_outcome(r.status), "to the goal"};
+  const Failure f =
+      r.stopped != StopReason::kNone ? stopped_failure(r.stopped) : Failure{attempt_outcome(r.status), "to the goal"};
   result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, f.outcome, f.detail});
   if (r.status == HybridAStarResult::Status::kSuccess) {
     result.outcome = PlanningResult::Outcome::kFound;

@@ -122,8 +122,8 @@ Selection select_candidate(const PlannerCandidates& pc, double margin) {
       it->second += r.count;
     }
   }
-  const auto top = std::max_element(totals.begin(), totals.end(),
-                                    [](const auto& a, const auto& b) { return a.second < b.second; });
+  const auto top =
+      std::max_element(totals.begin(), totals.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   sel.outcome = top->first;
   const auto total = pc.candidates.size();
   for (const Reason& r : reasons) {

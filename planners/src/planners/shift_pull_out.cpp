@@ -221,10 +221,10 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
   }
   const double yaw_dev = normalize_angle(start.yaw - center.yaw_at(s_start));
   if (std::abs(yaw_dev) > kMaxStartYawDeviation) {
-    out.failure = Failure{AttemptOutcome::kStartInvalid, "start heading deviates " +
-                                                             format_fixed(yaw_dev * 180.0 / M_PI, 1) +
-                                                             " deg from the road (limit " +
-                                                             format_fixed(kMaxStartYawDeviation * 180.0 / M_PI, 0) + ")"};
+    out.failure =
+        Failure{AttemptOutcome::kStartInvalid, "start heading deviates " + format_fixed(yaw_dev * 180.0 / M_PI, 1) +
+                                                   " deg from the road (limit " +
+                                                   format_fixed(kMaxStartYawDeviation * 180.0 / M_PI, 0) + ")"};
     return out;
   }
   const RoadEnd end = find_path_end(ctx, s_start);
@@ -264,8 +264,8 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
       }
       const double s_end = push_end_to_low_curvature(center, s_start + length, params.end_pose_curvature_threshold);
       if (s_end > end.s - 1e-6) {
-        candidate.rejection = Failure{AttemptOutcome::kNoGeometry,
-                                      end.is_goal ? "goal too close for the shift" : "road lanes too short for the shift"};
+        candidate.rejection = Failure{AttemptOutcome::kNoGeometry, end.is_goal ? "goal too close for the shift"
+                                                                               : "road lanes too short for the shift"};
         out.candidates.push_back(std::move(candidate));
         continue;
       }

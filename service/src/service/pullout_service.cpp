@@ -207,7 +207,10 @@ void PulloutService::run_job(PlanningJob& job) {
   } else {
     spdlog::info(
         "vehicle '{}' request {}: {}{}, {:.1f} ms: {}", request.vehicle_id, request.request_id,
-        outcome_name(result.outcome), result.stopped == StopReason::kNone ? "" : result.timed_out ? " (deadline)" : " (cancelled)",
+        outcome_name(result.outcome),
+        result.stopped == StopReason::kNone ? ""
+        : result.timed_out                  ? " (deadline)"
+                                            : " (cancelled)",
         result.planning_time_ms,
         result.outcome == PlanningResult::Outcome::kRejected ? format_issues(result.issues) : result.stop_reason);
     for (const PlannerAttempt& a : result.evaluation_table) {

@@ -87,8 +87,8 @@ struct HybridAStarResult {
   enum class Status { kSuccess, kStartOccupied, kGoalOccupied, kTimeout, kCancelled, kNodeLimit, kNoPath };
   Status status{Status::kNoPath};
   StopReason stopped{StopReason::kNone};  // kTimeout / kCancelled: the reason the stop condition gave
-  std::vector<Waypoint> waypoints;  // start ... goal (or the pose in the goal region)
-  double length{0.0};               // [m] driven, both directions
+  std::vector<Waypoint> waypoints;        // start ... goal (or the pose in the goal region)
+  double length{0.0};                     // [m] driven, both directions
   std::size_t expansions{0};
   std::size_t nodes{0};
   std::size_t shots{0};            // Reeds-Shepp analytic expansions tried

@@ -108,7 +108,8 @@ class StopCondition {
     const Clock::time_point now = Clock::now();
     if (!(budget_ms > 0.0)) return budget_ms <= 0.0 ? now : kNever;  // NaN: no limit
     if (!(budget_ms <= kMaxBudgetMs)) return kNever;                 // +inf, huge
-    const auto budget = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(budget_ms));
+    const auto budget =
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(budget_ms));
     return budget >= kNever - now ? kNever : now + budget;
   }
 
