@@ -88,7 +88,7 @@ void BM_PlanRouteOnMap(benchmark::State& state) {
       pullout::load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/map_shoulder.yaml");
   const pullout::StartPlanner planner(sc.vehicle, sc.parameters, {}, sc.map);
   for (auto _ : state) {
-    const pullout::PlanningResult r = planner.plan(sc.request, pullout::Deadline());
+    const pullout::PlanningResult r = planner.plan(sc.request, pullout::StopCondition());
     benchmark::DoNotOptimize(r.path.partial_paths.data());
   }
 }

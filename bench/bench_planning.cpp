@@ -24,7 +24,7 @@ void plan_scenario(benchmark::State& state, const std::string& name, double dead
   std::size_t attempts = 0;
   for (auto _ : state) {
     const pullout::PlanningResult r = planner.plan(
-        scenario.request, deadline_ms < 0.0 ? pullout::Deadline() : pullout::Deadline::after_ms(deadline_ms));
+        scenario.request, deadline_ms < 0.0 ? pullout::StopCondition() : pullout::StopCondition::after_ms(deadline_ms));
     attempts = r.evaluation_table.size();
     benchmark::DoNotOptimize(r.path.partial_paths.data());
   }

@@ -286,7 +286,7 @@ std::vector<double> measure_planning(const pullout::Scenario& scenario, const pu
   std::vector<double> out;
   for (int i = 0; i < warmup + plans; ++i) {
     const auto t0 = SteadyClock::now();
-    const pullout::PlanningResult result = planner.plan(scenario.request, pullout::Deadline());
+    const pullout::PlanningResult result = planner.plan(scenario.request, pullout::StopCondition());
     const double ms = ms_since(t0);
     if (result.outcome != pullout::PlanningResult::Outcome::kFound) throw std::runtime_error("planning found no path");
     if (i >= warmup) out.push_back(ms);

@@ -180,7 +180,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   config.distance_heuristic_weight = heuristic_weight;
   const pullout::HybridAStar planner(checker, config);
   const auto t0 = std::chrono::steady_clock::now();
-  const pullout::HybridAStarResult r = planner.plan(p.start, p.goal, pullout::Deadline::after_ms(budget_ms));
+  const pullout::HybridAStarResult r = planner.plan(p.start, p.goal, pullout::StopCondition::after_ms(budget_ms));
   Run run;
   run.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   run.success = r.status == pullout::HybridAStarResult::Status::kSuccess;

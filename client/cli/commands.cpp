@@ -16,8 +16,8 @@
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/parameters.hpp"
 #include "pullout/pipeline/start_planner.hpp"
+#include "pullout/search/stop_condition.hpp"
 #include "pullout/session/vehicle_session.hpp"
-#include "pullout/search/deadline.hpp"
 #include "report.hpp"
 #include "svg_writer.hpp"
 #include "text_output.hpp"
@@ -117,7 +117,7 @@ int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
   const auto now = SteadyClock::now();
   SessionEffects effects = session.on_request(request, {}, now);
   if (effects.search) {
-    const PlanningResult result = planner.plan(effects.search->request, Deadline::after_ms(budget_ms));
+    const PlanningResult result = planner.plan(effects.search->request, StopCondition::after_ms(budget_ms));
     effects = session.on_result(effects.search->sequence, result, now);
   }
   if (!effects.status) {

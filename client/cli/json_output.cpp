@@ -47,7 +47,8 @@ nlohmann::ordered_json to_json(const PlanReport& report) {
     table.push_back({{"planner", to_string(a.planner)},
                      {"margin", number(a.margin_m)},
                      {"backward_distance", number(a.backward_distance_m)},
-                     {"outcome", a.outcome}});
+                     {"outcome", to_string(a.outcome)},
+                     {"detail", a.detail}});
   }
   Json out;
   out["found"] = report.found;

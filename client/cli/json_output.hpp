@@ -17,8 +17,11 @@
 //                                              // order: [m], [rad], [m/s] (negative reversing)
 //     "start_pose": {"x": 0.0, "y": 0.0, "yaw": 0.0},   // [m], [rad]; null without a path
 //     "end_pose":   {"x": 0.0, "y": 0.0, "yaw": 0.0},
-//     "evaluation_table": [{"planner": "shift", "margin": 2.0, "backward_distance": 0.0,
-//                           "outcome": "collision"}],   // [m]
+//     "evaluation_table": [{"planner": "shift", "margin": 2.0, "backward_distance": 0.0,   // [m]
+//                           "outcome": "collision",     // success | collision | lane_departure |
+//                           // no_geometry | start_invalid | goal_invalid | timeout | cancelled |
+//                           // node_limit | no_path
+//                           "detail": "object 7 (4/4 candidates)"}],   // "" when none
 //     "planning_time_ms": 3.2,
 //     "reasons": ["..."],                      // why nothing was found; found: how the path ends
 //     "error": ""                              // rejected: "<field>: <problem>" lines

@@ -77,7 +77,7 @@ void print_report(std::ostream& out, const PlanReport& report) {
     out << format("  %-10s %10s %13s  %s\n", "planner", "margin [m]", "backward [m]", "outcome");
     for (const auto& a : report.evaluation_table) {
       out << format("  %-10s %10.2f %13.2f  %s\n", to_string(a.planner), a.margin_m, a.backward_distance_m,
-                    a.outcome.c_str());
+                    describe(a).c_str());
     }
   }
   out << format("planning time: %.2f ms\n", report.planning_time_ms);

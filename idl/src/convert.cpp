@@ -75,6 +75,10 @@ std::optional<ModelEnum> enum_from_msg(MsgEnum v, MsgEnum last) {
   return static_cast<ModelEnum>(raw);
 }
 
+// The last enumerators agree (the order is the model's comment's promise; a new outcome must be
+// added to both).
+static_assert(static_cast<std::uint32_t>(msg::OUTCOME_NO_PATH) == static_cast<std::uint32_t>(AttemptOutcome::kNoPath));
+
 template <typename ModelEnum, typename MsgEnum>
 ModelEnum checked_enum(MsgEnum v, MsgEnum last, ModelEnum fallback, const std::string& field, IssueSink& sink) {
   if (auto e = enum_from_msg<ModelEnum>(v, last)) return *e;
@@ -483,7 +487,8 @@ msg::PullOutStatus to_msg(const PullOutStatus& in) {
     a.planner(enum_to_msg<PlannerType, msg::PlannerType>(row.planner));
     a.margin_m(row.margin_m);
     a.backward_distance_m(row.backward_distance_m);
-    a.outcome(row.outcome);
+    a.outcome(enum_to_msg<AttemptOutcome, msg::AttemptOutcome>(row.outcome));
+    a.detail(row.detail);
     out.evaluation_table().push_back(std::move(a));
   }
   out.stop_reason(in.stop_reason);
@@ -498,6 +503,12 @@ msg::PullOutStatus to_msg(const PullOutStatus& in) {
 }
 
 PullOutStatus from_msg(const msg::PullOutStatus& in) {
+  std::vector<RequestIssue> ignored;
+  return from_msg(in, ignored);
+}
+
+PullOutStatus from_msg(const msg::PullOutStatus& in, std::vector<RequestIssue>& issues) {
+  IssueSink sink(issues);
   PullOutStatus out;
   out.vehicle_id = in.vehicle_id();
   out.request_id = in.request_id();
@@ -507,12 +518,21 @@ PullOutStatus from_msg(const msg::PullOutStatus& in) {
   out.segment_count = in.segment_count();
   out.planner_type = lenient_enum(in.planner_type(), msg::PLANNER_FREESPACE, PlannerType::kNone);
   out.evaluation_table.reserve(in.evaluation_table().size());
-  for (const auto& row : in.evaluation_table()) {
+  for (std::size_t i = 0; i < in.evaluation_table().size(); ++i) {
+    const msg::PlannerAttempt& row = in.evaluation_table()[i];
     PlannerAttempt a;
     a.planner = lenient_enum(row.planner(), msg::PLANNER_FREESPACE, PlannerType::kNone);
     a.margin_m = row.margin_m();
     a.backward_distance_m = row.backward_distance_m();
-    a.outcome = row.outcome();
+    // An outcome this build does not know (a newer sender, a corrupt sample) is reported; the row
+    // keeps the neutral kNoPath with the raw value in its detail.
+    const std::string field = indexed("evaluation_table", i) + ".outcome";
+    a.outcome = checked_enum(row.outcome(), msg::OUTCOME_NO_PATH, AttemptOutcome::kNoPath, field, sink);
+    a.detail = row.detail();
+    if (!enum_from_msg<AttemptOutcome>(row.outcome(), msg::OUTCOME_NO_PATH)) {
+      const std::string raw = "unknown outcome " + std::to_string(static_cast<std::uint32_t>(row.outcome()));
+      a.detail = a.detail.empty() ? raw : raw + ": " + a.detail;
+    }
     out.evaluation_table.push_back(std::move(a));
   }
   out.stop_reason = in.stop_reason();

@@ -46,7 +46,8 @@ PlanningResult found_result() {
   PlanningResult result;
   result.outcome = PlanningResult::Outcome::kFound;
   result.path = two_segment_path();
-  result.evaluation_table = {{PlannerType::kShift, 2.0, 0.0, "collision"}, {PlannerType::kShift, 1.0, 3.0, "success"}};
+  result.evaluation_table = {{PlannerType::kShift, 2.0, 0.0, AttemptOutcome::kCollision, "object 7 (4/4 candidates)"},
+                             {PlannerType::kShift, 1.0, 3.0, AttemptOutcome::kSuccess, ""}};
   result.planning_time_ms = 4.25;
   return result;
 }
@@ -101,7 +102,10 @@ TEST(JsonOutput, FoundPlanHasEveryField) {
   EXPECT_EQ(j["evaluation_table"][0]["planner"], "shift");
   EXPECT_DOUBLE_EQ(j["evaluation_table"][0]["margin"].get<double>(), 2.0);
   EXPECT_DOUBLE_EQ(j["evaluation_table"][1]["backward_distance"].get<double>(), 3.0);
+  EXPECT_EQ(j["evaluation_table"][0]["outcome"], "collision");
+  EXPECT_EQ(j["evaluation_table"][0]["detail"], "object 7 (4/4 candidates)");
   EXPECT_EQ(j["evaluation_table"][1]["outcome"], "success");
+  EXPECT_EQ(j["evaluation_table"][1]["detail"], "");
   EXPECT_DOUBLE_EQ(j["planning_time_ms"].get<double>(), 4.25);
   EXPECT_TRUE(j["reasons"].is_array() && j["reasons"].empty());
   EXPECT_EQ(j["error"], "");
@@ -187,13 +191,15 @@ TEST(JsonOutput, ServiceReplyUsesStatusTableAndState) {
   status.request_id = 7;
   status.state = ExecutionState::kExecuting;
   status.planner_type = PlannerType::kShift;
-  status.evaluation_table = {{PlannerType::kShift, 1.0, 0.0, "success"}};
+  status.evaluation_table = {{PlannerType::kShift, 1.0, 0.0, AttemptOutcome::kLaneDeparture, "2/4 candidates"}};
   status.planning_time_ms = 1.5;
   const nlohmann::ordered_json j = to_json(make_report(two_segment_path(), status));
   EXPECT_EQ(j["found"], true);
   EXPECT_EQ(j["state"], "executing");
   EXPECT_EQ(j["segments"].size(), 2u);
-  EXPECT_EQ(j["evaluation_table"].size(), 1u);
+  ASSERT_EQ(j["evaluation_table"].size(), 1u);
+  EXPECT_EQ(j["evaluation_table"][0]["outcome"], "lane_departure");
+  EXPECT_EQ(j["evaluation_table"][0]["detail"], "2/4 candidates");
   EXPECT_DOUBLE_EQ(j["planning_time_ms"].get<double>(), 1.5);
 
   PullOutStatus rejected;

@@ -8,10 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
 #include "../planners/path_oracles.hpp"
 #include "pullout/collision/footprint.hpp"
+#include "pullout/collision/object_checker.hpp"
 #include "pullout/config/scenario.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
@@ -47,7 +49,7 @@ class FreespaceScenario : public ::testing::TestWithParam<const char*> {};
 TEST_P(FreespaceScenario, FindsADrivablePath) {
   const Scenario sc = load(GetParam());
   const StartPlanner planner(sc.vehicle, sc.parameters);
-  const PlanningResult r = planner.plan(sc.request, Deadline::after_ms(5000));
+  const PlanningResult r = planner.plan(sc.request, StopCondition::after_ms(5000));
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
   const PullOutPath& path = r.path;
   EXPECT_EQ(path.planner_type, PlannerType::kFreespace);
@@ -134,7 +136,7 @@ INSTANTIATE_TEST_SUITE_P(Scenarios, FreespaceScenario, ::testing::ValuesIn(kFree
 TEST(FreespacePullOut, LanePlannersAloneCannotLeaveTheBoxedInSpot) {
   Scenario sc = load("freespace_boxed_in");
   sc.parameters.freespace_planner.enable_freespace_planner = false;
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
 }
 
@@ -163,9 +165,94 @@ TEST(FreespacePullOut, SplitsAtEveryCusp) {
 TEST(FreespacePullOut, TinyDeadlineGivesATimeout) {
   const Scenario sc = load("freespace_perpendicular_bay");
   const StartPlanner planner(sc.vehicle, sc.parameters);
-  const PlanningResult r = planner.plan(sc.request, Deadline::after_ms(1.0));
+  const PlanningResult r = planner.plan(sc.request, StopCondition::after_ms(1.0));
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
   EXPECT_TRUE(r.timed_out);
+}
+
+// Defect: the freespace search dropped the caller's cancellation (it kept only the earlier of the
+// two deadlines), so a superseded or shut-down search ran on up to time_limit. The work is bounded
+// by the search's own counters, not by the clock.
+TEST(FreespacePullOut, CancelledFlagStopsTheGoalSearchBeforeAnyExpansion) {
+  Scenario sc = load("freespace_parking_lot");
+  ASSERT_TRUE(sc.request.occupancy_grid.has_value());
+  FreespaceParameters p = sc.parameters.freespace_planner;
+  p.time_limit = 1e9;  // the own budget never ends it: only the flag can
+  const Costmap costmap = freespace_costmap(p, &*sc.request.occupancy_grid, nullptr, {}, sc.request.ego_pose, 0.0);
+  // Not cancelled: the search finds the path, with work done.
+  std::atomic<bool> cancel{false};
+  const StopCondition stop = StopCondition().with_cancel(&cancel);
+  const FreespaceGoalResult running =
+      plan_freespace_to_goal(costmap, sc.vehicle, p, sc.request.ego_pose, sc.request.goal_pose, stop);
+  ASSERT_EQ(running.status, HybridAStarResult::Status::kSuccess);
+  ASSERT_GT(running.expansions, 0u);
+  // Cancelled: no expansion at all.
+  cancel = true;
+  const FreespaceGoalResult r =
+      plan_freespace_to_goal(costmap, sc.vehicle, p, sc.request.ego_pose, sc.request.goal_pose, stop);
+  EXPECT_EQ(r.status, HybridAStarResult::Status::kCancelled);
+  EXPECT_EQ(r.stopped, StopReason::kCancelled);
+  EXPECT_EQ(r.expansions, 0u);
+  EXPECT_EQ(attempt_outcome(r.status), AttemptOutcome::kCancelled);
+}
+
+// The lane-based freespace pull-out, given the pipeline's context for the boxed-in spot.
+TEST(FreespacePullOut, CancelledFlagStopsThePullOutSearch) {
+  Scenario sc = load("freespace_boxed_in");
+  sc.parameters.freespace_planner.time_limit = 1e9;
+  const LaneWorld world(sc.request.lanes);
+  const LaneChain road = world.chain_through(*world.nearest_lane(to_vec(sc.request.ego_pose), LaneSubtype::kRoad));
+  std::vector<Obstacle> obstacles;
+  std::vector<Polygon> polygons;
+  for (const Object& o : sc.request.objects) {
+    obstacles.push_back({o.id, object_polygon(o)});
+    polygons.push_back(obstacles.back().polygon);
+  }
+  const ObjectChecker checker(vehicle_footprint(sc.vehicle), obstacles);
+  const PlanningContext ctx{
+      world,   road,     road, checker, sc.vehicle, sc.parameters, sc.request.goal_pose, 2.0, sc.request.ego_pose,
+      nullptr, &polygons};
+  std::atomic<bool> cancel{false};
+  const StopCondition stop = StopCondition().with_cancel(&cancel);
+  const PlannerCandidates running = FreespacePullOut().plan(ctx, sc.request.ego_pose, stop);
+  ASSERT_EQ(running.candidates.size(), 1u);  // it finds one when not cancelled
+  EXPECT_EQ(running.stopped, StopReason::kNone);
+  cancel = true;
+  const PlannerCandidates r = FreespacePullOut().plan(ctx, sc.request.ego_pose, stop);
+  EXPECT_TRUE(r.candidates.empty());
+  EXPECT_EQ(r.stopped, StopReason::kCancelled);
+  EXPECT_EQ(select_candidate(r, 0.1).outcome, AttemptOutcome::kCancelled);
+}
+
+// Through the pipeline: a pure freespace request whose search is cancelled reports it in its row.
+TEST(FreespacePullOut, CancelledGridOnlyRequestHasACancelledRow) {
+  Scenario sc = load("freespace_parking_lot");
+  sc.parameters.freespace_planner.time_limit = 1e9;
+  std::atomic<bool> cancel{true};
+  const PlanningResult r =
+      StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition().with_cancel(&cancel));
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  EXPECT_EQ(r.stopped, StopReason::kCancelled);
+  EXPECT_FALSE(r.timed_out);
+  ASSERT_EQ(r.evaluation_table.size(), 1u);
+  EXPECT_EQ(r.evaluation_table[0].planner, PlannerType::kFreespace);
+  EXPECT_EQ(r.evaluation_table[0].outcome, AttemptOutcome::kCancelled);
+}
+
+// freespace_planner.time_limit is the planner's own budget: it ends the freespace attempt
+// (kTimeout, the budget named in the detail), not the planning, which is not timed out.
+TEST(FreespacePullOut, OwnTimeLimitIsATimeoutRowNotAPlanningTimeout) {
+  Scenario sc = load("freespace_boxed_in");
+  sc.parameters.freespace_planner.time_limit = 0.0;
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  EXPECT_EQ(r.stopped, StopReason::kNone);
+  EXPECT_FALSE(r.timed_out);
+  ASSERT_FALSE(r.evaluation_table.empty());
+  const PlannerAttempt& last = r.evaluation_table.back();
+  EXPECT_EQ(last.planner, PlannerType::kFreespace);
+  EXPECT_EQ(last.outcome, AttemptOutcome::kTimeout);
+  EXPECT_NE(last.detail.find("budget"), std::string::npos) << last.detail;
 }
 
 TEST(FreespacePullOut, GridOnlyRequestsNeedTheFreespacePlanner) {
@@ -173,7 +260,7 @@ TEST(FreespacePullOut, GridOnlyRequestsNeedTheFreespacePlanner) {
   ASSERT_TRUE(sc.request.lanes.empty());
   ASSERT_TRUE(sc.request.occupancy_grid.has_value());
   sc.parameters.freespace_planner.enable_freespace_planner = false;
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
   ASSERT_FALSE(r.issues.empty());
   EXPECT_EQ(r.issues[0].field, "lanes");
@@ -186,10 +273,10 @@ TEST(FreespacePullOut, FreespaceInSearchPriorityRunsInItsPlace) {
   // The start candidates come from the lane-based search rules: keep the current pose one.
   sc.parameters.collision_check_margin_from_front_object = 0.0;
   sc.parameters.enable_back = false;
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline::after_ms(5000));
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition::after_ms(5000));
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
   EXPECT_EQ(r.path.planner_type, PlannerType::kFreespace);
-  EXPECT_EQ(r.evaluation_table.back().outcome, "success");
+  EXPECT_EQ(r.evaluation_table.back().outcome, AttemptOutcome::kSuccess);
 }
 
 }  // namespace

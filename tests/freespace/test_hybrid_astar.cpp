@@ -66,7 +66,7 @@ TEST(HybridAStar, OpenLotReachesTheExactGoal) {
   const HybridAStar planner(checker, config());
   const Pose2 start{6, 6, 0};
   const Pose2 goal{22, 22, M_PI / 2};
-  const HybridAStarResult r = planner.plan(start, goal, Deadline::after_ms(2000));
+  const HybridAStarResult r = planner.plan(start, goal, StopCondition::after_ms(2000));
   expect_drivable(checker, r, start, 5.2);
   EXPECT_TRUE(r.reached_exact_goal);
   EXPECT_NEAR(r.waypoints.back().pose.x, goal.x, 1e-9);
@@ -80,7 +80,7 @@ TEST(HybridAStar, GoalBehindAWallIsReachedAroundIt) {
   const HybridAStar planner(checker, config());
   const Pose2 start{5, 5, 0};
   const Pose2 goal{25, 5, 0};
-  const HybridAStarResult r = planner.plan(start, goal, Deadline::after_ms(3000));
+  const HybridAStarResult r = planner.plan(start, goal, StopCondition::after_ms(3000));
   expect_drivable(checker, r, start, 5.2);
   double max_y = 0.0;
   for (const auto& w : r.waypoints) max_y = std::max(max_y, w.pose.y);
@@ -94,7 +94,7 @@ TEST(HybridAStar, TurningAroundInANarrowCorridorNeedsReversing) {
   const HybridAStar planner(checker, config());
   const Pose2 start{20, 3.7, 0};
   const Pose2 goal{20, 3.7, M_PI};
-  const HybridAStarResult r = planner.plan(start, goal, Deadline::after_ms(3000));
+  const HybridAStarResult r = planner.plan(start, goal, StopCondition::after_ms(3000));
   expect_drivable(checker, r, start, 5.2);
   int changes = 0;
   for (std::size_t i = 1; i < r.waypoints.size(); ++i) {
@@ -113,7 +113,7 @@ TEST(HybridAStar, EveryPointOfThePathIsFreeNotOnlyTheTestedPoses) {
   const HybridAStar planner(checker, c);
   const Pose2 start{4, 10, 0};
   const Pose2 goal{9.65, 1.5, M_PI / 2};  // rear axle in the bay, nose to the aisle
-  const HybridAStarResult r = planner.plan(start, goal, Deadline::after_ms(5000));
+  const HybridAStarResult r = planner.plan(start, goal, StopCondition::after_ms(5000));
   ASSERT_EQ(r.status, HybridAStarResult::Status::kSuccess);
   ASSERT_GT(r.waypoints.size(), 500u);
   for (std::size_t i = 0; i < r.waypoints.size(); ++i) {
@@ -130,10 +130,11 @@ TEST(HybridAStar, TypedFailures) {
   const Costmap m = walled_map(30, 30, {box(14, 0, 15, 30)});  // a wall with no gap
   const GridCollisionChecker checker(m, kCar);
   const HybridAStar planner(checker, config());
-  EXPECT_EQ(planner.plan({14, 10, 0}, {25, 10, 0}, Deadline()).status, HybridAStarResult::Status::kStartOccupied);
-  EXPECT_EQ(planner.plan({5, 10, 0}, {14.5, 20, 0}, Deadline()).status, HybridAStarResult::Status::kGoalOccupied);
-  EXPECT_EQ(planner.plan({5, 10, 0}, {-50, 10, 0}, Deadline()).status, HybridAStarResult::Status::kGoalOccupied);
-  EXPECT_EQ(planner.plan({5, 10, 0}, {25, 10, 0}, Deadline::after_ms(5000)).status, HybridAStarResult::Status::kNoPath);
+  EXPECT_EQ(planner.plan({14, 10, 0}, {25, 10, 0}, StopCondition()).status, HybridAStarResult::Status::kStartOccupied);
+  EXPECT_EQ(planner.plan({5, 10, 0}, {14.5, 20, 0}, StopCondition()).status, HybridAStarResult::Status::kGoalOccupied);
+  EXPECT_EQ(planner.plan({5, 10, 0}, {-50, 10, 0}, StopCondition()).status, HybridAStarResult::Status::kGoalOccupied);
+  EXPECT_EQ(planner.plan({5, 10, 0}, {25, 10, 0}, StopCondition::after_ms(5000)).status,
+            HybridAStarResult::Status::kNoPath);
 }
 
 // How promptly the search stops is a figure for bench/bench_planning (BM_Plan_FreespaceTinyDeadline),
@@ -144,9 +145,10 @@ TEST(HybridAStar, DeadlineGivesATimeout) {
   const Costmap m = walled_map(100, 100, {box(80, 80, 81, 88), box(80, 89.7, 81, 100), box(80, 80, 100, 81)});
   const GridCollisionChecker checker(m, kCar);
   const HybridAStar planner(checker, config());
-  const HybridAStarResult r = planner.plan({10, 10, 0}, {90, 90, 0}, Deadline::after_ms(5));
+  const HybridAStarResult r = planner.plan({10, 10, 0}, {90, 90, 0}, StopCondition::after_ms(5));
   EXPECT_EQ(r.status, HybridAStarResult::Status::kTimeout);
-  EXPECT_EQ(planner.plan({10, 10, 0}, {90, 90, 0}, Deadline::after_ms(0)).status, HybridAStarResult::Status::kTimeout);
+  EXPECT_EQ(planner.plan({10, 10, 0}, {90, 90, 0}, StopCondition::after_ms(0)).status,
+            HybridAStarResult::Status::kTimeout);
 }
 
 }  // namespace

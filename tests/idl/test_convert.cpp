@@ -2,6 +2,7 @@
 #include "pullout/idl/convert.hpp"
 
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <string>
 
@@ -354,7 +355,8 @@ TEST(Convert, StatusRoundTrip) {
   in.current_path_idx = 1;
   in.segment_count = 2;
   in.planner_type = PlannerType::kShift;
-  in.evaluation_table = {{PlannerType::kShift, 2.0, 0.0, "collision"}, {PlannerType::kShift, 1.0, 0.0, "success"}};
+  in.evaluation_table = {{PlannerType::kShift, 2.0, 0.0, AttemptOutcome::kCollision, "object 7 (4/4 candidates)"},
+                         {PlannerType::kShift, 1.0, 0.0, AttemptOutcome::kSuccess, ""}};
   in.stop_reason = "";
   in.error = "a: b\nc: d";
   in.planning_time_ms = 12.5;
@@ -368,7 +370,9 @@ TEST(Convert, StatusRoundTrip) {
   EXPECT_EQ(out.planner_type, PlannerType::kShift);
   ASSERT_EQ(out.evaluation_table.size(), 2u);
   EXPECT_DOUBLE_EQ(out.evaluation_table[0].margin_m, 2.0);
-  EXPECT_EQ(out.evaluation_table[1].outcome, "success");
+  EXPECT_EQ(out.evaluation_table[0].outcome, AttemptOutcome::kCollision);
+  EXPECT_EQ(out.evaluation_table[0].detail, "object 7 (4/4 candidates)");
+  EXPECT_EQ(out.evaluation_table[1].outcome, AttemptOutcome::kSuccess);
   EXPECT_EQ(out.error, in.error);
   EXPECT_DOUBLE_EQ(out.planning_time_ms, 12.5);
 
@@ -396,6 +400,58 @@ TEST(Convert, StatusRoundTrip) {
   msg::PullOutStatus m = to_msg(in);
   m.state(static_cast<msg::ExecutionState>(99));
   EXPECT_EQ(from_msg(m).state, ExecutionState::kIdle);
+}
+
+TEST(Convert, EveryAttemptOutcomeRoundTrips) {
+  const AttemptOutcome all[] = {AttemptOutcome::kSuccess,       AttemptOutcome::kCollision,
+                                AttemptOutcome::kLaneDeparture, AttemptOutcome::kNoGeometry,
+                                AttemptOutcome::kStartInvalid,  AttemptOutcome::kGoalInvalid,
+                                AttemptOutcome::kTimeout,       AttemptOutcome::kCancelled,
+                                AttemptOutcome::kNodeLimit,     AttemptOutcome::kNoPath};
+  PullOutStatus in;
+  in.vehicle_id = "car-7";
+  for (std::size_t i = 0; i < std::size(all); ++i) {
+    in.evaluation_table.push_back({PlannerType::kGeometric, 0.5, 1.0, all[i], "detail " + std::to_string(i)});
+  }
+  const msg::PullOutStatus m = to_msg(in);
+  // The wire value is the IDL's enumerator (the model's order), written out independently here.
+  ASSERT_EQ(m.evaluation_table().size(), std::size(all));
+  EXPECT_EQ(m.evaluation_table()[0].outcome(), msg::OUTCOME_SUCCESS);
+  EXPECT_EQ(m.evaluation_table()[2].outcome(), msg::OUTCOME_LANE_DEPARTURE);
+  EXPECT_EQ(m.evaluation_table()[7].outcome(), msg::OUTCOME_CANCELLED);
+  EXPECT_EQ(m.evaluation_table()[9].outcome(), msg::OUTCOME_NO_PATH);
+  std::vector<RequestIssue> issues;
+  const PullOutStatus out = from_msg(m, issues);
+  EXPECT_TRUE(issues.empty()) << dump(issues);
+  ASSERT_EQ(out.evaluation_table.size(), std::size(all));
+  for (std::size_t i = 0; i < std::size(all); ++i) {
+    EXPECT_EQ(out.evaluation_table[i].outcome, all[i]) << i;
+    EXPECT_EQ(out.evaluation_table[i].detail, "detail " + std::to_string(i));
+    EXPECT_EQ(out.evaluation_table[i].planner, PlannerType::kGeometric);
+  }
+}
+
+TEST(Convert, UnknownAttemptOutcomeIsReportedByField) {
+  PullOutStatus in;
+  in.evaluation_table = {{PlannerType::kShift, 1.0, 0.0, AttemptOutcome::kSuccess, ""},
+                         {PlannerType::kShift, 0.5, 0.0, AttemptOutcome::kCollision, "object 3"}};
+  msg::PullOutStatus m = to_msg(in);
+  m.evaluation_table()[1].outcome(static_cast<msg::AttemptOutcome>(10));  // one past the last
+  std::vector<RequestIssue> issues;
+  const PullOutStatus out = from_msg(m, issues);
+  ASSERT_EQ(issues.size(), 1u) << dump(issues);
+  EXPECT_EQ(issues[0].field, "evaluation_table[1].outcome");
+  EXPECT_NE(issues[0].problem.find("10"), std::string::npos) << issues[0].problem;
+  // The row is kept, neutral, with the raw value for people.
+  ASSERT_EQ(out.evaluation_table.size(), 2u);
+  EXPECT_EQ(out.evaluation_table[0].outcome, AttemptOutcome::kSuccess);
+  EXPECT_EQ(out.evaluation_table[1].outcome, AttemptOutcome::kNoPath);
+  EXPECT_EQ(out.evaluation_table[1].detail, "unknown outcome 10: object 3");
+  m.evaluation_table()[0].outcome(static_cast<msg::AttemptOutcome>(0xFFFFFFFFu));
+  issues.clear();
+  from_msg(m, issues);
+  EXPECT_TRUE(has_issue(issues, "evaluation_table[0].outcome")) << dump(issues);
+  EXPECT_TRUE(has_issue(issues, "evaluation_table[1].outcome")) << dump(issues);
 }
 
 TEST(Convert, TimeSaturatesOutsideInt32Seconds) {

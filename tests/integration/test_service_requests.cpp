@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "integration_support.hpp"
+#include "pullout/model/names.hpp"
 
 namespace pullout::integration {
 namespace {
@@ -166,9 +167,8 @@ void expect_boxed_in_reply(Client& client, const Scenario& scenario, PullOutStat
   std::ostringstream text;
   for (const PlannerAttempt& row : no_path->evaluation_table) {
     text << "\n  planner " << static_cast<int>(row.planner) << ", margin " << row.margin_m << " m, backward "
-         << row.backward_distance_m << " m: " << row.outcome;
-    EXPECT_FALSE(row.outcome.empty());
-    EXPECT_NE(row.outcome, "success");
+         << row.backward_distance_m << " m: " << describe(row);
+    EXPECT_NE(row.outcome, AttemptOutcome::kSuccess);
   }
   status = *no_path;
   table = text.str();

@@ -16,6 +16,7 @@
 #include "pullout/maps/lanelet_map.hpp"
 #include "pullout/maps/map_lanes.hpp"
 #include "pullout/maps/osm_loader.hpp"
+#include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 
 namespace pullout {
@@ -51,7 +52,7 @@ std::string dump(const std::vector<PlannerAttempt>& table) {
   std::string out;
   for (const auto& a : table) {
     out += "  planner " + std::to_string(static_cast<int>(a.planner)) + " margin " + std::to_string(a.margin_m) +
-           " back " + std::to_string(a.backward_distance_m) + ": " + a.outcome + "\n";
+           " back " + std::to_string(a.backward_distance_m) + ": " + describe(a) + "\n";
   }
   return out;
 }
@@ -142,7 +143,7 @@ TEST_F(OwnMap, PullsOutFromTheShoulderOntoTheRoute) {
   car.object_class = ObjectClass::kCar;
   car.pose = {32.0, 3.25, 0.0};
   r.objects.push_back(car);
-  const PlanningResult result = planner().plan(r, Deadline());
+  const PlanningResult result = planner().plan(r, StopCondition());
   expect_drivable(result, r, *map_, config_.vehicle, config_.start_planner);
   EXPECT_EQ(result.path.planner_type, PlannerType::kShift);
   EXPECT_TRUE(planner().validate(r).empty());
@@ -180,7 +181,7 @@ TEST_F(OwnMap, ExtendsAShortRouteBackwardAndForward) {
 TEST_F(OwnMap, BadRoutesAreRejectedNamingTheField) {
   const Pose2 ego{20.0, 3.25, 0.0};
   const auto issues = [&](std::vector<std::int64_t> route, Pose2 at) {
-    return planner().plan(route_request(std::move(route), at, {180.0, 0.0, 0.0}), Deadline()).issues;
+    return planner().plan(route_request(std::move(route), at, {180.0, 0.0, 0.0}), StopCondition()).issues;
   };
   auto i = issues({101, 4242}, ego);
   EXPECT_TRUE(has_issue(i, "route_lanelet_ids[1]", "unknown lanelet id 4242")) << dump(i);
@@ -201,10 +202,10 @@ TEST_F(OwnMap, BadRoutesAreRejectedNamingTheField) {
   // Lanes and a route at once.
   PullOutRequest both = route_request({101}, ego, {});
   both.lanes.push_back(to_lane(map_->lanelet(*map_->find(101))).value());
-  EXPECT_TRUE(has_issue(planner().plan(both, Deadline()).issues, "lanes", "not both"));
+  EXPECT_TRUE(has_issue(planner().plan(both, StopCondition()).issues, "lanes", "not both"));
   // No map loaded: the request says so.
   const StartPlanner no_map(config_.vehicle, config_.start_planner);
-  EXPECT_TRUE(has_issue(no_map.plan(route_request({101}, ego, {}), Deadline()).issues, "route_lanelet_ids",
+  EXPECT_TRUE(has_issue(no_map.plan(route_request({101}, ego, {}), StopCondition()).issues, "route_lanelet_ids",
                         "no Lanelet2 map is loaded"));
 }
 
@@ -291,7 +292,7 @@ TEST_P(SharedMaps, PullOutFromEveryShoulderLanelet) {
     PullOutRequest r = route_request(route, ego, {});
     const LaneWorld last({*to_lane(map->lanelet(*map->find(route.back())))});
     r.goal_pose = last.lanes()[0].centerline.pose_at(last.lanes()[0].centerline.length());
-    const PlanningResult result = planner.plan(r, Deadline());
+    const PlanningResult result = planner.plan(r, StopCondition());
     expect_drivable(result, r, *map, config.vehicle, config.start_planner);
     ++tried;
   }

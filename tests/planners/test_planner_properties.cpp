@@ -98,7 +98,7 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
   const Scenario sc = load(c.scenario);
   const StartPlannerParameters params = case_parameters(sc, c.planner);
   const StartPlanner planner(sc.vehicle, params);
-  const PlanningResult r = planner.plan(case_request(sc, c.planner), Deadline());
+  const PlanningResult r = planner.plan(case_request(sc, c.planner), StopCondition());
   if (!c.found) {
     // Nothing to find: it must come as a stop path with reasons.
     ASSERT_NE(r.outcome, PlanningResult::Outcome::kFound) << to_string(r.path.planner_type) << " found a path";
@@ -115,7 +115,7 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
   ASSERT_EQ(path.planner_type, c.planner) << "the path comes from another planner";
   ASSERT_GE(path.partial_paths.size(), 1u);
   ASSERT_EQ(path.pairs_terminal_velocity_and_accel.size(), path.partial_paths.size()) << "one pair per segment";
-  ASSERT_EQ(r.evaluation_table.back().outcome, "success");
+  ASSERT_EQ(r.evaluation_table.back().outcome, AttemptOutcome::kSuccess);
   const bool freespace = c.planner == PlannerType::kFreespace;
   const FreespaceParameters& fp = params.freespace_planner;
 
@@ -329,7 +329,7 @@ class ScenarioExpectations : public ::testing::TestWithParam<const char*> {};
 TEST_P(ScenarioExpectations, MatchTheFile) {
   const Scenario sc = load(GetParam());
   const StartPlanner planner(sc.vehicle, sc.parameters, {}, sc.map);
-  const PlanningResult r = planner.plan(sc.request, Deadline());
+  const PlanningResult r = planner.plan(sc.request, StopCondition());
   ASSERT_TRUE(sc.expect.found.has_value()) << "every bundled scenario states whether a path exists";
   EXPECT_EQ(r.path.found, *sc.expect.found) << r.stop_reason;
   if (sc.expect.planner) {
@@ -353,7 +353,7 @@ INSTANTIATE_TEST_SUITE_P(Bundled, ScenarioExpectations, ::testing::ValuesIn(kExp
 
 TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {
   const Scenario sc = load("car_close_ahead");
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
   ASSERT_TRUE(r.path.found);
   ASSERT_GE(r.path.partial_paths.size(), 2u);
   EXPECT_LT(direction_of(r.path.partial_paths[0]), 0.0);
@@ -365,7 +365,7 @@ TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {
 
 TEST(ScenarioSpecifics, ParallelSpotStopsBetweenTheArcsWithConsistentPairs) {
   const Scenario sc = load("parallel_spot");
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
   ASSERT_TRUE(r.path.found);
   ASSERT_EQ(r.path.planner_type, PlannerType::kGeometric);
   ASSERT_EQ(r.path.partial_paths.size(), 2u);  // divide_pull_out_path: true
@@ -381,7 +381,7 @@ TEST(ScenarioSpecifics, ParallelSpotStopsBetweenTheArcsWithConsistentPairs) {
 
   StartPlannerParameters single = sc.parameters;
   single.divide_pull_out_path = false;
-  const PlanningResult r1 = StartPlanner(sc.vehicle, single).plan(sc.request, Deadline());
+  const PlanningResult r1 = StartPlanner(sc.vehicle, single).plan(sc.request, StopCondition());
   ASSERT_TRUE(r1.path.found);
   EXPECT_EQ(r1.path.partial_paths.size(), 1u);
 }

@@ -147,7 +147,7 @@ TEST(PublishedPath, EveryPointOfEveryFoundPathIsClearOfTheObjects) {
     for (const auto& priority : priorities) {
       StartPlannerParameters params = sc.parameters;
       params.search_priority = priority;
-      const PlanningResult r = StartPlanner(sc.vehicle, params, {}, sc.map).plan(sc.request, Deadline());
+      const PlanningResult r = StartPlanner(sc.vehicle, params, {}, sc.map).plan(sc.request, StopCondition());
       if (r.outcome != PlanningResult::Outcome::kFound) continue;
       ++found;
       cut += r.path_end.stops_before_object ? 1 : 0;
@@ -165,7 +165,7 @@ TEST(PublishedPath, ScenariosThatStopBeforeAnObjectDo) {
   std::size_t with_key = 0;
   for (const std::string& name : bundled_scenarios()) {
     const Scenario sc = load_scenario(kScenarioDir + "/" + name + ".yaml");
-    const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters, {}, sc.map).plan(sc.request, Deadline());
+    const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters, {}, sc.map).plan(sc.request, StopCondition());
     if (!sc.expect.stops_before_object) {
       if (r.outcome == PlanningResult::Outcome::kFound) EXPECT_FALSE(r.path_end.stops_before_object) << name;
       continue;

@@ -9,7 +9,7 @@
 #include "pullout/safety/rss_check.hpp"
 #include "pullout/safety/safety_monitor.hpp"
 #include "pullout/safety/stop_path.hpp"
-#include "pullout/search/deadline.hpp"
+#include "pullout/search/stop_condition.hpp"
 #include "test_world.hpp"
 
 namespace pullout {
@@ -229,7 +229,7 @@ TEST(SafetyMonitor, PlannedShiftPathAgainstTraffic) {
   PullOutRequest request = test::straight_shoulder_request();
   request.lanes = long_lanes();
   const PlanningResult r =
-      StartPlanner(VehicleInfo{}, StartPlannerParameters{}).plan(request, Deadline::after_ms(1000));
+      StartPlanner(VehicleInfo{}, StartPlannerParameters{}).plan(request, StopCondition::after_ms(1000));
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound);
   SafetyMonitor m(StartPlannerParameters{}, VehicleInfo{}, long_lanes(), {car(1, -20.0, 0.0, 10.0)}, r.path);
   EXPECT_FALSE(m.evaluate(request.ego_pose, 0.0, 0, false).safe);
@@ -282,7 +282,7 @@ class TrafficScenarios : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(TrafficScenarios, SafetyVerdictMatchesTheFile) {
   const Scenario sc = load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/" + GetParam() + ".yaml");
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters, {}, sc.map).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters, {}, sc.map).plan(sc.request, StopCondition());
   ASSERT_TRUE(r.path.found) << r.stop_reason;
   ASSERT_TRUE(sc.expect.safe.has_value());
   ASSERT_NE(r.world, nullptr);
@@ -298,7 +298,7 @@ INSTANTIATE_TEST_SUITE_P(Bundled, TrafficScenarios,
 
 TEST(TrafficScenarios, CannotPassIsTheBypassNotTheCheck) {
   const Scenario sc = load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/traffic_cannot_pass.yaml");
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, Deadline());
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
   ASSERT_TRUE(r.path.found);
   SafetyMonitor m(sc.parameters, sc.vehicle, sc.request.lanes, sc.request.objects, r.path);
   EXPECT_TRUE(m.evaluate(sc.request.ego_pose, 0.0, 0, false).preventing_rear);

@@ -162,7 +162,7 @@ std::size_t index_of(const PathWithLaneId& path, const Pose2& pose) {
 TEST(ShiftPullOut, StraightShoulderPathIsContinuousAndEndsOnTheCenterline) {
   const StartPlanner planner(VehicleInfo{}, StartPlannerParameters{});
   const auto req = test::straight_shoulder_request();
-  const PlanningResult r = planner.plan(req, Deadline());
+  const PlanningResult r = planner.plan(req, StopCondition());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
   const PullOutPath& path = r.path;
   EXPECT_TRUE(path.found);
@@ -204,7 +204,7 @@ TEST(ShiftPullOut, StraightShoulderPathIsContinuousAndEndsOnTheCenterline) {
               1e-9);
   // The gentlest candidate wins when nothing is in the way, at the first margin.
   ASSERT_EQ(r.evaluation_table.size(), 1u);
-  EXPECT_EQ(r.evaluation_table[0].outcome, "success");
+  EXPECT_EQ(r.evaluation_table[0].outcome, AttemptOutcome::kSuccess);
   EXPECT_DOUBLE_EQ(r.evaluation_table[0].margin_m, 2.0);
   // Worked numbers for L = 3.25 m, a_lat = 0.15, j = 0.5, v_road = 13.89: t_j = a / j = 0.3 s;
   // the closed form L = a (t_j + t_a) (2 t_j + t_a) gives t_a^2 + 0.9 t_a + 0.18 = 3.25 / 0.15,
@@ -228,7 +228,7 @@ TEST(ShiftPullOut, StraightShoulderPathIsContinuousAndEndsOnTheCenterline) {
 TEST(ShiftPullOut, CurvedRoadStaysWithinTheSteeringLimitAndEndsOnTheCenterline) {
   const StartPlanner planner(VehicleInfo{}, StartPlannerParameters{});
   const auto req = test::curved_road_request();
-  const PlanningResult r = planner.plan(req, Deadline());
+  const PlanningResult r = planner.plan(req, StopCondition());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
   const PathWithLaneId& seg = r.path.partial_paths.at(0);
   const PathProperties m = measure(seg, 0, seg.points.size() - 1);
@@ -247,7 +247,7 @@ TEST(ShiftPullOut, StartOnTheCenterlineDrivesStraightOn) {
   const StartPlanner planner(VehicleInfo{}, StartPlannerParameters{});
   auto req = test::straight_shoulder_request();
   req.ego_pose = {10.0, 0.0, 0.0};
-  const PlanningResult r = planner.plan(req, Deadline());
+  const PlanningResult r = planner.plan(req, StopCondition());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound);
   EXPECT_EQ(r.path.turn_signal, TurnSignal::kNone);
   for (const auto& pt : r.path.partial_paths[0].points) EXPECT_NEAR(pt.pose.y, 0.0, 1e-9);
@@ -259,10 +259,11 @@ TEST(ShiftPullOut, StartHeadingFarFromTheLaneIsRefused) {
   const StartPlanner planner(VehicleInfo{}, params);
   auto req = test::straight_shoulder_request();
   req.ego_pose.yaw = 0.8;
-  const PlanningResult r = planner.plan(req, Deadline());
+  const PlanningResult r = planner.plan(req, StopCondition());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
   ASSERT_FALSE(r.evaluation_table.empty());
-  EXPECT_NE(r.evaluation_table[0].outcome.find("start heading deviates"), std::string::npos);
+  EXPECT_EQ(r.evaluation_table[0].outcome, AttemptOutcome::kStartInvalid);
+  EXPECT_NE(r.evaluation_table[0].detail.find("start heading deviates"), std::string::npos);
 }
 
 }  // namespace

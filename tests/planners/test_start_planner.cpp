@@ -2,11 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
+#include "pullout/config/scenario.hpp"
+#include "pullout/model/names.hpp"
 #include "test_world.hpp"
 
 namespace pullout {
@@ -54,15 +58,16 @@ double min_clearance(const PullOutPath& path, const std::vector<Object>& objects
 TEST(StartPlanner, ParkedCarAheadForcesASmallerMargin) {
   auto req = test::straight_shoulder_request();
   req.objects.push_back(test::parked_car(7, 24.0, 3.25));
-  const PlanningResult r = shift_only_planner().plan(req, Deadline());
+  const PlanningResult r = shift_only_planner().plan(req, StopCondition());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
   // Every larger margin was tried first and failed for the car.
   ASSERT_GE(r.evaluation_table.size(), 2u);
   for (std::size_t i = 0; i + 1 < r.evaluation_table.size(); ++i) {
-    EXPECT_NE(r.evaluation_table[i].outcome.find("collision with object 7"), std::string::npos);
+    EXPECT_EQ(r.evaluation_table[i].outcome, AttemptOutcome::kCollision);
+    EXPECT_NE(r.evaluation_table[i].detail.find("object 7"), std::string::npos) << r.evaluation_table[i].detail;
   }
   const PlannerAttempt& winner = r.evaluation_table.back();
-  EXPECT_EQ(winner.outcome, "success");
+  EXPECT_EQ(winner.outcome, AttemptOutcome::kSuccess);
   EXPECT_LT(winner.margin_m, 2.0);
   // The path never touches the car (independent check over the whole path to the end pose).
   EXPECT_GT(min_clearance(r.path, req.objects), 0.0);
@@ -72,7 +77,7 @@ TEST(StartPlanner, BoxedInGivesAStopPathWithEveryAttemptsReason) {
   auto req = test::straight_shoulder_request();
   req.objects.push_back(test::parked_car(7, 16.5, 3.25));  // 0.46 m ahead of the bumper
   req.objects.push_back(test::parked_car(8, 5.0, 3.25));   // behind
-  const PlanningResult r = shift_only_planner().plan(req, Deadline());
+  const PlanningResult r = shift_only_planner().plan(req, StopCondition());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
   EXPECT_FALSE(r.path.found);
   EXPECT_EQ(r.path.planner_type, PlannerType::kStop);
@@ -83,7 +88,7 @@ TEST(StartPlanner, BoxedInGivesAStopPathWithEveryAttemptsReason) {
     EXPECT_DOUBLE_EQ(pt.pose.x, req.ego_pose.x);
   }
   EXPECT_EQ(r.evaluation_table.size(), StartPlannerParameters{}.collision_check_margins.size());
-  for (const auto& a : r.evaluation_table) EXPECT_NE(a.outcome.find("collision"), std::string::npos);
+  for (const auto& a : r.evaluation_table) EXPECT_EQ(a.outcome, AttemptOutcome::kCollision) << describe(a);
   ASSERT_FALSE(r.path.reasons.empty());
   EXPECT_NE(r.path.reasons[0].find("margin 0.10"), std::string::npos) << r.path.reasons[0];
   EXPECT_FALSE(r.stop_reason.empty());
@@ -94,22 +99,102 @@ TEST(StartPlanner, MovingObjectsAreNotStaticObstacles) {
   Object passing = test::parked_car(7, 16.5, 3.25);
   passing.velocity_mps = 5.0;
   req.objects.push_back(passing);
-  EXPECT_EQ(default_planner().plan(req, Deadline()).outcome, PlanningResult::Outcome::kFound);
+  EXPECT_EQ(default_planner().plan(req, StopCondition()).outcome, PlanningResult::Outcome::kFound);
 }
 
 TEST(StartPlanner, ExpiredDeadlineEndsTheSearchWithTimeout) {
   auto req = test::straight_shoulder_request();
-  const PlanningResult r = default_planner().plan(req, Deadline::after_ms(0.0));
+  const PlanningResult r = default_planner().plan(req, StopCondition::after_ms(0.0));
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
   EXPECT_TRUE(r.timed_out);
+  EXPECT_EQ(r.stopped, StopReason::kDeadline);
   EXPECT_NE(r.stop_reason.find("deadline"), std::string::npos);
   EXPECT_FALSE(r.path.found);
+}
+
+// Typed outcomes on the shared scenario files: each row's outcome is a value, the detail says
+// which object (or which limit).
+Scenario load(const std::string& name) {
+  return load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/" + name + ".yaml");
+}
+
+TEST(StartPlannerOutcomes, CollisionRowsNameTheObject) {
+  const Scenario sc = load("parked_car_ahead");
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  ASSERT_GE(r.evaluation_table.size(), 2u);
+  for (std::size_t i = 0; i + 1 < r.evaluation_table.size(); ++i) {
+    const PlannerAttempt& a = r.evaluation_table[i];
+    EXPECT_EQ(a.outcome, AttemptOutcome::kCollision) << describe(a);
+    EXPECT_NE(a.detail.find("object 7"), std::string::npos) << a.detail;
+  }
+  EXPECT_EQ(r.evaluation_table.back().outcome, AttemptOutcome::kSuccess);
+}
+
+TEST(StartPlannerOutcomes, LaneDepartureRows) {
+  Scenario sc = load("straight_shoulder");
+  sc.parameters.enable_back = false;
+  sc.parameters.freespace_planner.enable_freespace_planner = false;
+  // A departure check footprint 3 m wider on each side than the car leaves any lane.
+  sc.parameters.lane_departure_check_expansion_margin = 3.0;
+  sc.parameters.allow_check_shift_path_lane_departure_override = false;
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  ASSERT_FALSE(r.evaluation_table.empty());
+  for (const PlannerAttempt& a : r.evaluation_table) {
+    EXPECT_EQ(a.outcome, AttemptOutcome::kLaneDeparture) << to_string(a.planner) << ": " << describe(a);
+  }
+  ASSERT_FALSE(r.path.reasons.empty());
+  EXPECT_NE(r.path.reasons[0].find("lane_departure"), std::string::npos) << r.path.reasons[0];
+}
+
+TEST(StartPlannerOutcomes, BoxedInStartCandidateIsStartInvalid) {
+  const Scenario sc = load("boxed_in");
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  ASSERT_FALSE(r.evaluation_table.empty());
+  EXPECT_EQ(r.evaluation_table[0].planner, PlannerType::kNone);
+  EXPECT_EQ(r.evaluation_table[0].outcome, AttemptOutcome::kStartInvalid);
+  EXPECT_NE(r.evaluation_table[0].detail.find("object 8"), std::string::npos) << r.evaluation_table[0].detail;
+}
+
+TEST(StartPlannerOutcomes, FreespaceTimeLimitGivesATimeoutRow) {
+  Scenario sc = load("freespace_boxed_in");
+  sc.parameters.freespace_planner.time_limit = 0.0;
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
+  ASSERT_FALSE(r.evaluation_table.empty());
+  EXPECT_EQ(r.evaluation_table.back().planner, PlannerType::kFreespace);
+  EXPECT_EQ(r.evaluation_table.back().outcome, AttemptOutcome::kTimeout);
+  EXPECT_FALSE(r.timed_out);  // the planner's budget, not the planning deadline
+}
+
+TEST(StartPlannerOutcomes, CancelledSearchGivesACancelledRow) {
+  const Scenario sc = load("freespace_parking_lot");  // grid only: one freespace search
+  std::atomic<bool> cancel{true};
+  const PlanningResult r =
+      StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition().with_cancel(&cancel));
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  EXPECT_EQ(r.stopped, StopReason::kCancelled);
+  ASSERT_EQ(r.evaluation_table.size(), 1u);
+  EXPECT_EQ(r.evaluation_table[0].outcome, AttemptOutcome::kCancelled);
+}
+
+TEST(StartPlannerOutcomes, CancelledLaneSearchStopsBeforeTheFirstAttempt) {
+  const Scenario sc = load("straight_shoulder");
+  std::atomic<bool> cancel{true};
+  const PlanningResult r =
+      StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition().with_cancel(&cancel));
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+  EXPECT_EQ(r.stopped, StopReason::kCancelled);
+  EXPECT_FALSE(r.timed_out);
+  EXPECT_TRUE(r.evaluation_table.empty());
+  EXPECT_NE(r.stop_reason.find("cancelled"), std::string::npos) << r.stop_reason;
 }
 
 TEST(StartPlanner, SearchPolicyOverrideAndUnavailablePlanner) {
   auto req = test::straight_shoulder_request();
   req.overrides.search_priority = {PlannerType::kStop};  // not a planner that can be searched
-  const PlanningResult r = default_planner().plan(req, Deadline());
+  const PlanningResult r = default_planner().plan(req, StopCondition());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
   EXPECT_TRUE(has_issue(r, "overrides.search_priority[0]"));
 }
@@ -119,7 +204,7 @@ TEST(StartPlannerValidation, NonFiniteValuesNameTheField) {
   req.ego_pose.x = std::numeric_limits<double>::quiet_NaN();
   req.goal_pose.yaw = std::numeric_limits<double>::infinity();
   req.lanes[1].left_bound[1].y = std::numeric_limits<double>::quiet_NaN();
-  const PlanningResult r = default_planner().plan(req, Deadline());
+  const PlanningResult r = default_planner().plan(req, StopCondition());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
   EXPECT_TRUE(has_issue(r, "ego_pose.x"));
   EXPECT_TRUE(has_issue(r, "goal_pose.yaw"));
@@ -130,28 +215,28 @@ TEST(StartPlannerValidation, NonFiniteValuesNameTheField) {
 TEST(StartPlannerValidation, EmptyAndDegenerateLanes) {
   auto req = test::straight_shoulder_request();
   req.lanes.clear();
-  EXPECT_TRUE(has_issue(default_planner().plan(req, Deadline()), "lanes"));
+  EXPECT_TRUE(has_issue(default_planner().plan(req, StopCondition()), "lanes"));
 
   req = test::straight_shoulder_request();
   req.lanes[0].right_bound = req.lanes[0].left_bound;  // zero area
   req.lanes[1].left_bound.resize(1);
-  const PlanningResult r = default_planner().plan(req, Deadline());
+  const PlanningResult r = default_planner().plan(req, StopCondition());
   EXPECT_TRUE(has_issue(r, "lanes[0]"));
   EXPECT_TRUE(has_issue(r, "lanes[1].left_bound"));
 
   req = test::straight_shoulder_request();
   req.lanes[0].subtype = LaneSubtype::kRoadShoulder;
-  EXPECT_TRUE(has_issue(default_planner().plan(req, Deadline()), "lanes"));
+  EXPECT_TRUE(has_issue(default_planner().plan(req, StopCondition()), "lanes"));
 
   req = test::straight_shoulder_request();
   req.lanes[1].id = req.lanes[0].id;
-  EXPECT_TRUE(has_issue(default_planner().plan(req, Deadline()), "lanes[1].id"));
+  EXPECT_TRUE(has_issue(default_planner().plan(req, StopCondition()), "lanes[1].id"));
 }
 
 TEST(StartPlannerValidation, StartPoseOffTheLanes) {
   auto req = test::straight_shoulder_request();
   req.ego_pose = {50.0, 40.0, 0.0};
-  const PlanningResult r = default_planner().plan(req, Deadline());
+  const PlanningResult r = default_planner().plan(req, StopCondition());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
   ASSERT_TRUE(has_issue(r, "ego_pose"));
   EXPECT_NE(format_issues(r.issues).find("on no lane"), std::string::npos);
@@ -175,7 +260,7 @@ TEST(StartPlannerValidation, RouteWithoutMapAndBadDeadline) {
   auto req = test::straight_shoulder_request();
   req.route_lanelet_ids = {4618};
   req.deadline_ms = -5.0;
-  const PlanningResult r = default_planner().plan(req, Deadline());
+  const PlanningResult r = default_planner().plan(req, StopCondition());
   EXPECT_TRUE(has_issue(r, "route_lanelet_ids"));
   EXPECT_TRUE(has_issue(r, "deadline_ms"));
 }
@@ -191,7 +276,7 @@ TEST(StartPlanner, ReversingMovesBackwardsWhenTheVehicleFacesAgainstItsLane) {
   req.objects.push_back(test::parked_car(7, 19.04, 3.25));  // 3 m ahead of the bumper
   StartPlannerParameters p;
   p.search_priority = {PlannerType::kShift};
-  const PlanningResult r = StartPlanner(VehicleInfo{}, p).plan(req, Deadline());
+  const PlanningResult r = StartPlanner(VehicleInfo{}, p).plan(req, StopCondition());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
   ASSERT_GE(r.path.partial_paths.size(), 2u);
   const auto& reverse = r.path.partial_paths[0].points;

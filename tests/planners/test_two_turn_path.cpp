@@ -117,7 +117,7 @@ TEST(SearchPolicy, OrdersTheAttemptsInsideAMargin) {
     PullOutRequest req = sc.request;
     req.overrides = {};
     std::vector<std::pair<PlannerType, double>> out;
-    for (const auto& a : StartPlanner(sc.vehicle, p).plan(req, Deadline()).evaluation_table) {
+    for (const auto& a : StartPlanner(sc.vehicle, p).plan(req, StopCondition()).evaluation_table) {
       if (a.planner != PlannerType::kNone && a.margin_m == p.collision_check_margins.front()) {
         out.emplace_back(a.planner, a.backward_distance_m);
       }

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "pullout/config/scenario.hpp"
-#include "pullout/search/deadline.hpp"
+#include "pullout/search/stop_condition.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "pullout/session/vehicle_session.hpp"
 #include "test_world.hpp"
@@ -56,7 +56,7 @@ class Session : public ::testing::Test {
     EXPECT_TRUE(ordered.search.has_value());
     EXPECT_EQ(ordered.status->state, ExecutionState::kPlanning);
     if (!ordered.search) return ordered;
-    const PlanningResult result = planner_->plan(ordered.search->request, Deadline());
+    const PlanningResult result = planner_->plan(ordered.search->request, StopCondition());
     return session_->on_result(ordered.search->sequence, result, now_);
   }
   // One sample `dt` after the previous one, on both clocks.
@@ -128,7 +128,7 @@ TEST_F(Session, AResultOfASupersededSearchIsDropped) {
   second.goal_pose.x = 80.0;
   SessionEffects later = session_->on_request(second, {}, now_);
   ASSERT_TRUE(first.search && later.search);
-  const PlanningResult result = planner_->plan(first.search->request, Deadline());
+  const PlanningResult result = planner_->plan(first.search->request, StopCondition());
   EXPECT_TRUE(session_->on_result(first.search->sequence, result, now_).empty());
   EXPECT_EQ(status().state, ExecutionState::kPlanning);
   EXPECT_EQ(status().request_id, 2u);

@@ -15,11 +15,6 @@ constexpr double kTrimDistance = 1.0;  // [m] Autoware's trim around the end pos
 constexpr double kSamePose = 1e-6;     // [m]
 constexpr double kWindowExtra = 10.0;  // [m] costmap window beyond the farthest end pose
 
-Deadline search_deadline(const FreespaceParameters& p, const Deadline& deadline) {
-  const Deadline own = Deadline::after_ms(p.time_limit);
-  return own.at() < deadline.at() ? Deadline(own.at(), nullptr) : deadline;
-}
-
 double path_length(const PathWithLaneId& path) {
   double len = 0.0;
   for (std::size_t i = 1; i < path.points.size(); ++i) {
@@ -35,6 +30,26 @@ TerminalVelocityAccel stopping_pair(double v, double length) {
 }
 
 }  // namespace
+
+AttemptOutcome attempt_outcome(HybridAStarResult::Status status) {
+  switch (status) {
+    case HybridAStarResult::Status::kSuccess:
+      return AttemptOutcome::kSuccess;
+    case HybridAStarResult::Status::kStartOccupied:
+      return AttemptOutcome::kStartInvalid;
+    case HybridAStarResult::Status::kGoalOccupied:
+      return AttemptOutcome::kGoalInvalid;
+    case HybridAStarResult::Status::kTimeout:
+      return AttemptOutcome::kTimeout;
+    case HybridAStarResult::Status::kCancelled:
+      return AttemptOutcome::kCancelled;
+    case HybridAStarResult::Status::kNodeLimit:
+      return AttemptOutcome::kNodeLimit;
+    case HybridAStarResult::Status::kNoPath:
+      return AttemptOutcome::kNoPath;
+  }
+  return AttemptOutcome::kNoPath;
+}
 
 HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const FreespaceParameters& p) {
   HybridAStarConfig c;
@@ -104,12 +119,14 @@ SplitPath split_at_cusps(const std::vector<Waypoint>& w, double velocity) {
 
 FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const VehicleInfo& vehicle,
                                            const FreespaceParameters& p, const Pose2& start, const Pose2& goal,
-                                           const Deadline& deadline) {
+                                           const StopCondition& stop) {
   FreespaceGoalResult out;
   const GridCollisionChecker checker(costmap, freespace_footprint(vehicle, p));
   HybridAStarConfig config = freespace_search_config(vehicle, p);
-  const HybridAStarResult r = HybridAStar(checker, config).plan(start, goal, search_deadline(p, deadline));
+  const HybridAStarResult r = HybridAStar(checker, config).plan(start, goal, stop.with_budget_ms(p.time_limit));
   out.status = r.status;
+  out.stopped = r.stopped;
+  out.expansions = r.expansions;
   if (r.status != HybridAStarResult::Status::kSuccess) return out;
   SplitPath split = split_at_cusps(r.waypoints, p.velocity);
   out.path.partial_paths = std::move(split.partial_paths);
@@ -122,14 +139,17 @@ FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const Vehicle
 }
 
 PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2& start,
-                                         const Deadline& deadline) const {
+                                         const StopCondition& stop) const {
   PlannerCandidates out;
   if (std::hypot(start.x - ctx.ego.x, start.y - ctx.ego.y) > kSamePose) {
-    out.failure = "freespace plans from the current pose only";
+    out.failure = Failure{AttemptOutcome::kStartInvalid, "freespace plans from the current pose only"};
     return out;
   }
   const FreespaceParameters& p = parameters_;
-  const Deadline until = search_deadline(p, deadline);
+  // One budget (time_limit) for every end pose; the caller's deadline and cancellation stay in.
+  const StopCondition until = stop.with_budget_ms(p.time_limit);
+  out.stopped = until.check();
+  if (out.stopped != StopReason::kNone) return out;  // before the costmap, the heaviest set-up
   const std::vector<Polygon> no_obstacles;
   const std::vector<Polygon>& obstacles = ctx.obstacle_polygons != nullptr ? *ctx.obstacle_polygons : no_obstacles;
   const double half_window = p.end_pose_search_end_distance + ctx.vehicle.length_m() + kWindowExtra;
@@ -140,23 +160,23 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
 
   const Polyline& center = ctx.road.centerline;
   const double s_ego = center.project(to_vec(ctx.ego)).s;
-  std::string last_failure = "no end pose on the road ahead";
+  Failure last_failure{AttemptOutcome::kGoalInvalid, "no end pose on the road ahead"};
   for (double d = p.end_pose_search_start_distance; d <= p.end_pose_search_end_distance + 1e-9;
        d += p.end_pose_search_interval) {
     const double s_end = s_ego + d;
     if (s_end > center.length()) break;
-    if (until.expired()) {
-      out.timed_out = true;
-      break;
-    }
+    out.stopped = until.check();
+    if (out.stopped != StopReason::kNone) break;
     const Pose2 end_pose = center.pose_at(s_end);
     HybridAStarResult r = search.plan(start, end_pose, until);
-    if (r.status == HybridAStarResult::Status::kTimeout) {
-      out.timed_out = true;
+    if (r.stopped != StopReason::kNone) {
+      out.stopped = r.stopped;
       break;
     }
     if (r.status != HybridAStarResult::Status::kSuccess) {
-      last_failure = std::string("end pose ") + format_fixed(d, 1) + " m ahead: " + to_string(r.status);
+      last_failure = Failure{attempt_outcome(r.status),
+                             std::string("end pose ") + format_fixed(d, 1) + " m ahead: " + to_string(r.status)};
+      if (r.status == HybridAStarResult::Status::kStartOccupied) break;  // the same for every end pose
       continue;
     }
     PathCandidate candidate;
@@ -220,7 +240,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
     out.candidates.push_back(std::move(candidate));
     return out;
   }
-  out.failure = out.timed_out ? "timeout" : last_failure;
+  if (out.stopped == StopReason::kNone) out.failure = last_failure;
   return out;
 }
 

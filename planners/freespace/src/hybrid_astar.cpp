@@ -14,13 +14,13 @@ namespace fd = freespace_detail;
 namespace {
 
 constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
-constexpr std::size_t kDeadlineCheckInterval = 16;  // expansions between clock reads
-constexpr int kShotCandidates = 3;                  // Reeds-Shepp words tried per shot, cheapest first
-constexpr double kShotDistancePerInterval = 4.0;    // [m] heuristic distance per expansion between shots
-constexpr double kReedsSheppRange = 4.0;            // [turning radii] see heuristic()
-constexpr double kCoarseSpacing = 1.0;              // [m] first-pass sample spacing of a shot
-constexpr double kSweepGrowth = 0.5;                // [cells] footprint growth between tested poses
-constexpr double kFineSweepGrowth = 0.125;          // [cells] the same where kSweepGrowth refuses
+constexpr std::size_t kStopCheckInterval = 16;    // expansions between checks of the stop condition
+constexpr int kShotCandidates = 3;                // Reeds-Shepp words tried per shot, cheapest first
+constexpr double kShotDistancePerInterval = 4.0;  // [m] heuristic distance per expansion between shots
+constexpr double kReedsSheppRange = 4.0;          // [turning radii] see heuristic()
+constexpr double kCoarseSpacing = 1.0;            // [m] first-pass sample spacing of a shot
+constexpr double kSweepGrowth = 0.5;              // [cells] footprint growth between tested poses
+constexpr double kFineSweepGrowth = 0.125;        // [cells] the same where kSweepGrowth refuses
 
 double wrap(double a) {
   a = std::fmod(a + kTwoPi / 2.0, kTwoPi);
@@ -61,7 +61,7 @@ class Search {
         sweep_{checker_, swept_checker_, kSweepGrowth * costmap_.resolution(), fine_checker_,
                kFineSweepGrowth * costmap_.resolution()} {}
 
-  HybridAStarResult run(const Deadline& deadline) {
+  HybridAStarResult run(const StopCondition& stop) {
     HybridAStarResult result;
     double start_clearance = 0.0;
     if (checker_.collides(start_, start_clearance)) {
@@ -78,10 +78,11 @@ class Search {
     add_node(start_node);
     Finish finish;
     std::size_t since_shot = 0;
+    bool node_limit = false;
     while (!open_.empty()) {
-      if (result.expansions % kDeadlineCheckInterval == 0 && deadline.expired()) {
-        result.status = HybridAStarResult::Status::kTimeout;
-        break;
+      if (result.expansions % kStopCheckInterval == 0) {
+        result.stopped = stop.check();
+        if (result.stopped != StopReason::kNone) break;
       }
       const auto [f, index] = open_.top();
       open_.pop();
@@ -106,12 +107,18 @@ class Search {
           break;
         }
       }
-      if (nodes_.size() >= config_.max_nodes) break;
+      if (nodes_.size() >= config_.max_nodes) {
+        node_limit = true;
+        break;
+      }
       expand(index);
     }
     result.nodes = nodes_.size();
     if (finish.node < 0) {
-      if (result.status != HybridAStarResult::Status::kTimeout) result.status = HybridAStarResult::Status::kNoPath;
+      result.status = result.stopped == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
+                      : result.stopped != StopReason::kNone    ? HybridAStarResult::Status::kTimeout
+                      : node_limit                             ? HybridAStarResult::Status::kNodeLimit
+                                                               : HybridAStarResult::Status::kNoPath;
       return result;
     }
     result.status = HybridAStarResult::Status::kSuccess;
@@ -329,6 +336,10 @@ const char* to_string(HybridAStarResult::Status status) {
       return "goal occupied";
     case HybridAStarResult::Status::kTimeout:
       return "timeout";
+    case HybridAStarResult::Status::kCancelled:
+      return "cancelled";
+    case HybridAStarResult::Status::kNodeLimit:
+      return "node limit";
     case HybridAStarResult::Status::kNoPath:
       return "no path";
   }
@@ -338,9 +349,17 @@ const char* to_string(HybridAStarResult::Status status) {
 HybridAStar::HybridAStar(const GridCollisionChecker& checker, const HybridAStarConfig& config)
     : checker_(checker), config_(config) {}
 
-HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const Deadline& deadline) const {
+HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const StopCondition& stop) const {
+  // Stopped before it starts: no heuristic grid either (the costliest part of the set-up).
+  if (const StopReason reason = stop.check(); reason != StopReason::kNone) {
+    HybridAStarResult result;
+    result.stopped = reason;
+    result.status =
+        reason == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled : HybridAStarResult::Status::kTimeout;
+    return result;
+  }
   Search search(checker_, config_, start, goal);
-  return search.run(deadline);
+  return search.run(stop);
 }
 
 }  // namespace pullout

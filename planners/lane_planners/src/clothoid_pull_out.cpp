@@ -9,7 +9,7 @@
 namespace pullout {
 
 PlannerCandidates ClothoidPullOut::plan(const PlanningContext& ctx, const Pose2& start,
-                                        const Deadline& deadline) const {
+                                        const StopCondition& stop) const {
   const auto& p = ctx.parameters;
   PlannerCandidates out;
   const Polyline window = turn_window(ctx, start);
@@ -18,14 +18,13 @@ PlannerCandidates ClothoidPullOut::plan(const PlanningContext& ctx, const Pose2&
   const double rate = p.clothoid_max_steer_angle_rate_deg_per_sec * M_PI / 180.0;
   const double v_lane = speed_limit_at(ctx, ctx.road.centerline.project(to_vec(start)).s);
   for (double steer_deg : p.clothoid_max_steer_angles_deg) {
-    if (deadline.expired()) {
-      out.timed_out = true;
-      break;
-    }
+    out.stopped = stop.check();
+    if (out.stopped != StopReason::kNone) break;
     const double steer = steer_deg * M_PI / 180.0;
     PathCandidate candidate;
     if (steer > ctx.vehicle.max_steer_angle_rad) {
-      candidate.rejection = "steer angle " + format_fixed(steer_deg, 1) + " deg exceeds the vehicle's maximum";
+      candidate.rejection = Failure{AttemptOutcome::kNoGeometry,
+                                    "steer angle " + format_fixed(steer_deg, 1) + " deg exceeds the vehicle's maximum"};
       out.candidates.push_back(std::move(candidate));
       continue;
     }
@@ -33,7 +32,7 @@ PlannerCandidates ClothoidPullOut::plan(const PlanningContext& ctx, const Pose2&
     const double clothoid_length = v0 * steer / rate;
     const auto turns = solve_two_turn(start, window, {kappa, kappa / clothoid_length, 0.0});
     if (!turns) {
-      candidate.rejection = "no clothoid path to the centerline";
+      candidate.rejection = Failure{AttemptOutcome::kNoGeometry, "no clothoid path to the centerline"};
       out.candidates.push_back(std::move(candidate));
       continue;
     }

@@ -13,7 +13,7 @@ constexpr int kTangentLengths = 10;  // 0..9 m, as Autoware's end-pose offsets
 }
 
 PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2& start,
-                                         const Deadline& deadline) const {
+                                         const StopCondition& stop) const {
   const auto& p = ctx.parameters;
   PlannerCandidates out;
   const double steer = ctx.vehicle.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale;
@@ -21,14 +21,12 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
   const Polyline window = turn_window(ctx, start);
   const double v = p.geometric_pull_out_velocity;
   for (int k = 0; k < kTangentLengths; ++k) {
-    if (deadline.expired()) {
-      out.timed_out = true;
-      break;
-    }
+    out.stopped = stop.check();
+    if (out.stopped != StopReason::kNone) break;
     const auto turns = solve_two_turn(start, window, {kappa, 0.0, static_cast<double>(k)});
     if (!turns) {
       PathCandidate none;
-      none.rejection = "no two-arc path to the centerline";
+      none.rejection = Failure{AttemptOutcome::kNoGeometry, "no two-arc path to the centerline"};
       out.candidates.push_back(std::move(none));
       continue;
     }

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <sstream>
 
 #include "pullout/collision/footprint.hpp"
+#include "pullout/model/names.hpp"
 
 namespace pullout {
 
@@ -60,31 +60,91 @@ std::string format_fixed(double value, int precision) {
   return os.str();
 }
 
+Failure stopped_failure(StopReason reason) {
+  switch (reason) {
+    case StopReason::kCancelled:
+      return {AttemptOutcome::kCancelled, ""};
+    case StopReason::kBudget:
+      return {AttemptOutcome::kTimeout, "the planner's time budget"};
+    default:
+      return {AttemptOutcome::kTimeout, "the planning deadline"};
+  }
+}
+
 Selection select_candidate(const PlannerCandidates& pc, double margin) {
   Selection sel;
   if (pc.candidates.empty()) {
-    sel.outcome = pc.timed_out ? "timeout" : (pc.failure.empty() ? "no path found" : pc.failure);
+    if (pc.stopped != StopReason::kNone) {
+      const Failure f = stopped_failure(pc.stopped);
+      sel.outcome = f.outcome;
+      sel.detail = f.detail;
+    } else if (pc.failure) {
+      sel.outcome = pc.failure->outcome;
+      sel.detail = pc.failure->detail;
+    } else {
+      sel.outcome = AttemptOutcome::kNoPath;
+    }
     return sel;
   }
-  std::map<std::string, int> reasons;
+  // The reasons in order of first appearance (the preferred candidate's first), with counts.
+  struct Reason {
+    Failure failure;
+    int count{0};
+  };
+  std::vector<Reason> reasons;
+  const auto count = [&reasons](AttemptOutcome outcome, const std::string& detail) {
+    for (Reason& r : reasons) {
+      if (r.failure.outcome == outcome && r.failure.detail == detail) {
+        ++r.count;
+        return;
+      }
+    }
+    reasons.push_back({{outcome, detail}, 1});
+  };
   for (const PathCandidate& c : pc.candidates) {
-    if (!c.rejection.empty()) {
-      ++reasons[c.rejection];
+    if (c.rejection) {
+      count(c.rejection->outcome, c.rejection->detail);
     } else if (c.clearance < margin) {
-      ++reasons["collision with object " + std::to_string(c.nearest_obstacle)];
+      count(AttemptOutcome::kCollision, "object " + std::to_string(c.nearest_obstacle));
     } else {
       sel.chosen = &c;
-      sel.outcome = "success";
+      sel.outcome = AttemptOutcome::kSuccess;
       return sel;
     }
   }
-  const auto total = pc.candidates.size();
-  for (const auto& [reason, count] : reasons) {
-    if (!sel.outcome.empty()) sel.outcome += "; ";
-    sel.outcome += reason;
-    if (total > 1) sel.outcome += " (" + std::to_string(count) + "/" + std::to_string(total) + " candidates)";
+  // The outcome of most candidates (summed over details), the first met on a tie.
+  std::vector<std::pair<AttemptOutcome, int>> totals;
+  for (const Reason& r : reasons) {
+    auto it = std::find_if(totals.begin(), totals.end(), [&r](const auto& t) { return t.first == r.failure.outcome; });
+    if (it == totals.end()) {
+      totals.emplace_back(r.failure.outcome, r.count);
+    } else {
+      it->second += r.count;
+    }
   }
-  if (pc.timed_out) sel.outcome += "; timeout";
+  const auto top =
+      std::max_element(totals.begin(), totals.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  sel.outcome = top->first;
+  const auto total = pc.candidates.size();
+  for (const Reason& r : reasons) {
+    std::string text = r.failure.outcome == sel.outcome ? r.failure.detail : to_string(r.failure.outcome);
+    if (r.failure.outcome != sel.outcome && !r.failure.detail.empty()) text += ": " + r.failure.detail;
+    if (total > 1) {
+      const std::string counted = std::to_string(r.count) + "/" + std::to_string(total) + " candidates";
+      text = text.empty() ? counted : text + " (" + counted + ")";
+    }
+    if (text.empty()) continue;
+    if (!sel.detail.empty()) sel.detail += "; ";
+    sel.detail += text;
+  }
+  if (pc.stopped != StopReason::kNone) {
+    // Cut short: the candidates checked so far are the detail, the stop is the outcome.
+    const Failure f = stopped_failure(pc.stopped);
+    const std::string checked = sel.detail.empty() ? std::string(to_string(sel.outcome))
+                                                   : std::string(to_string(sel.outcome)) + ": " + sel.detail;
+    sel.outcome = f.outcome;
+    sel.detail = (f.detail.empty() ? std::string() : f.detail + "; ") + "checked before: " + checked;
+  }
   return sel;
 }
 
@@ -116,18 +176,19 @@ void check_candidate(const PlanningContext& ctx, const std::vector<Pose2>& poses
   candidate.clearance = c.distance;
   candidate.nearest_obstacle = c.obstacle_id;
   if (c.distance < kTouchingDistance) {
-    candidate.rejection = "collision with object " + std::to_string(c.obstacle_id);
+    candidate.rejection = Failure{AttemptOutcome::kCollision, "object " + std::to_string(c.obstacle_id)};
     return;
   }
   for (std::size_t i = checks.section_last + 1; i <= checks.contact_last && i < poses.size(); ++i) {
     const auto hit = ctx.objects.clearance(poses[i], kTouchingDistance);
     if (hit.distance < kTouchingDistance) {
-      candidate.rejection = "collision with object " + std::to_string(hit.obstacle_id) + " near the end pose";
+      candidate.rejection =
+          Failure{AttemptOutcome::kCollision, "object " + std::to_string(hit.obstacle_id) + " near the end pose"};
       return;
     }
   }
   if (checks.check_lanes && first_lane_departure(ctx, poses, 0, checks.departure_last, checks.expansion)) {
-    candidate.rejection = "lane departure";
+    candidate.rejection = Failure{AttemptOutcome::kLaneDeparture, ""};
   }
 }
 

@@ -204,25 +204,27 @@ std::vector<double> lateral_acc_samples(const LanePlannerParameters& p) {
   return out;
 }
 
-PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start, const Deadline& deadline) const {
+PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& start, const StopCondition& stop) const {
   const auto& params = ctx.parameters;
   const Polyline& center = ctx.road.centerline;
   PlannerCandidates out;
   if (center.size() < 2) {
-    out.failure = "no road centerline";
+    out.failure = Failure{AttemptOutcome::kNoGeometry, "no road centerline"};
     return out;
   }
   const auto proj = center.project(to_vec(start));
   const double s_start = proj.s;
   const double shift_length = proj.lateral;
   if (s_start < 0.0 || s_start >= center.length()) {
-    out.failure = "start pose is not alongside the road lanes";
+    out.failure = Failure{AttemptOutcome::kStartInvalid, "start pose is not alongside the road lanes"};
     return out;
   }
   const double yaw_dev = normalize_angle(start.yaw - center.yaw_at(s_start));
   if (std::abs(yaw_dev) > kMaxStartYawDeviation) {
-    out.failure = "start heading deviates " + format_fixed(yaw_dev * 180.0 / M_PI, 1) + " deg from the road (limit " +
-                  format_fixed(kMaxStartYawDeviation * 180.0 / M_PI, 0) + ")";
+    out.failure =
+        Failure{AttemptOutcome::kStartInvalid, "start heading deviates " + format_fixed(yaw_dev * 180.0 / M_PI, 1) +
+                                                   " deg from the road (limit " +
+                                                   format_fixed(kMaxStartYawDeviation * 180.0 / M_PI, 0) + ")"};
     return out;
   }
   const RoadEnd end = find_path_end(ctx, s_start);
@@ -249,10 +251,8 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
   }
 
   for (const ShiftKinematics& k : kinematics) {
-    if (deadline.expired()) {
-      out.timed_out = true;
-      break;
-    }
+    out.stopped = stop.check();
+    if (out.stopped != StopReason::kNone) break;
     PathCandidate candidate;
     double length = k.distance;
     std::optional<ShiftShape> shape;
@@ -264,7 +264,8 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
       }
       const double s_end = push_end_to_low_curvature(center, s_start + length, params.end_pose_curvature_threshold);
       if (s_end > end.s - 1e-6) {
-        candidate.rejection = end.is_goal ? "goal too close for the shift" : "road lanes too short for the shift";
+        candidate.rejection = Failure{AttemptOutcome::kNoGeometry, end.is_goal ? "goal too close for the shift"
+                                                                               : "road lanes too short for the shift"};
         out.candidates.push_back(std::move(candidate));
         continue;
       }

@@ -145,7 +145,7 @@ std::vector<std::string> no_path_reasons(const std::vector<PlannerAttempt>& atte
   for (const PlannerAttempt& a : attempts) {
     if (a.planner == PlannerType::kNone || a.margin_m != last_margin) continue;
     reasons.push_back(std::string(to_string(a.planner)) + " at margin " + format_margin(a.margin_m) + " m, backward " +
-                      format_margin(a.backward_distance_m) + " m: " + a.outcome);
+                      format_margin(a.backward_distance_m) + " m: " + describe(a));
   }
   return reasons;
 }
@@ -196,7 +196,7 @@ std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) 
 
 bool StartPlanner::grid_only_allowed() const { return parameters_.freespace_planner.enable_freespace_planner; }
 
-PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const Deadline& deadline) const {
+PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const StopCondition& stop) const {
   PlanningResult result;
   const FreespaceParameters& p = parameters_.freespace_planner;
   std::vector<Polygon> obstacles;
@@ -206,24 +206,28 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
     obstacles.push_back(object_polygon(o));
   }
   const Costmap costmap = freespace_costmap(p, &*request.occupancy_grid, nullptr, obstacles, request.ego_pose, 0.0);
-  FreespaceGoalResult r = plan_freespace_to_goal(costmap, vehicle_, p, request.ego_pose, request.goal_pose, deadline);
+  FreespaceGoalResult r = plan_freespace_to_goal(costmap, vehicle_, p, request.ego_pose, request.goal_pose, stop);
   const double margin = 0.5 * p.vehicle_shape_margin;
-  result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, to_string(r.status)});
+  const Failure f =
+      r.stopped != StopReason::kNone ? stopped_failure(r.stopped) : Failure{attempt_outcome(r.status), "to the goal"};
+  result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, f.outcome, f.detail});
   if (r.status == HybridAStarResult::Status::kSuccess) {
     result.outcome = PlanningResult::Outcome::kFound;
     result.path = std::move(r.path);
     publish_checked(result, static_obstacle_checker(request, vehicle_, parameters_), margin, parameters_);
     return result;
   }
-  result.timed_out = r.status == HybridAStarResult::Status::kTimeout;
+  // Only the caller's limits make the planning time out; freespace's own time_limit is in the row.
+  if (r.stopped == StopReason::kDeadline || r.stopped == StopReason::kCancelled) result.stopped = r.stopped;
+  result.timed_out = result.stopped == StopReason::kDeadline;
   result.outcome = PlanningResult::Outcome::kNoPath;
   result.path = make_stop_path(request);
-  result.stop_reason = std::string("freespace to the goal: ") + to_string(r.status);
+  result.stop_reason = "freespace to the goal: " + describe(result.evaluation_table.back());
   result.path.reasons.push_back(result.stop_reason);
   return result;
 }
 
-PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline& deadline) const {
+PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondition& stop) const {
   const auto t0 = std::chrono::steady_clock::now();
   PlanningResult result;
   const std::vector<Lane>* planned_lanes = nullptr;  // the lanes planned on, once known
@@ -246,7 +250,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
     return result;
   }
   if (request.lanes.empty() && request.route_lanelet_ids.empty()) {  // validation allowed it: a grid and freespace
-    result = plan_grid_only(request, deadline);
+    result = plan_grid_only(request, stop);
     finish(result);
     return result;
   }
@@ -328,7 +332,8 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   const StartCandidateSearch search = search_start_candidates(context, params, request.ego_pose);
   const std::vector<StartCandidate>& starts = search.candidates;
   for (const auto& skipped : search.skipped) {
-    result.evaluation_table.push_back({PlannerType::kNone, 0.0, skipped.backward_distance, skipped.reason});
+    result.evaluation_table.push_back(
+        {PlannerType::kNone, 0.0, skipped.backward_distance, AttemptOutcome::kStartInvalid, skipped.reason});
   }
   // The order of (candidate, planner) pairs inside one margin, per search_policy.
   std::vector<std::pair<std::size_t, std::size_t>> order;
@@ -358,16 +363,18 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   std::vector<std::optional<PlannerCandidates>> planned(starts.size() * planners.size());
   for (double margin : params.collision_check_margins) {
     for (const auto& [ci, pi] : order) {
-      if (deadline.expired()) {
-        result.timed_out = true;
-        break;
-      }
+      result.stopped = stop.check();
+      if (result.stopped != StopReason::kNone) break;
       const StartCandidate& start = starts[ci];
       auto& slot = planned[ci * planners.size() + pi];
-      if (!slot) slot = planners[pi]->plan(context, start.pose, deadline);
-      result.timed_out = result.timed_out || slot->timed_out;
+      if (!slot) slot = planners[pi]->plan(context, start.pose, stop);
+      // The caller's limits end the whole search; a planner's own budget only its attempt.
+      if (slot->stopped == StopReason::kDeadline || slot->stopped == StopReason::kCancelled) {
+        result.stopped = slot->stopped;
+      }
       const Selection sel = select_candidate(*slot, margin);
-      result.evaluation_table.push_back({planners[pi]->type(), margin, start.backward_distance, sel.outcome});
+      result.evaluation_table.push_back(
+          {planners[pi]->type(), margin, start.backward_distance, sel.outcome, sel.detail});
       if (sel.chosen != nullptr) {
         accept(*sel.chosen, planners[pi]->type());
         if (start.backward_distance > 0.0) {
@@ -383,21 +390,24 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
         finish(result);
         return result;
       }
+      if (result.stopped != StopReason::kNone) break;
     }
-    if (result.timed_out) break;
+    if (result.stopped != StopReason::kNone) break;
   }
 
   // Nothing found: the freespace fallback (unless it was searched in the order already).
   const bool freespace_listed = std::find(params.search_priority.begin(), params.search_priority.end(),
                                           PlannerType::kFreespace) != params.search_priority.end();
-  if (params.freespace_planner.enable_freespace_planner && !freespace_listed && !result.timed_out) {
+  if (params.freespace_planner.enable_freespace_planner && !freespace_listed && result.stopped == StopReason::kNone) {
     const PlannerCandidates fallback =
-        FreespacePullOut(params.freespace_planner).plan(context, request.ego_pose, deadline);
-    result.timed_out = fallback.timed_out;
+        FreespacePullOut(params.freespace_planner).plan(context, request.ego_pose, stop);
+    if (fallback.stopped == StopReason::kDeadline || fallback.stopped == StopReason::kCancelled) {
+      result.stopped = fallback.stopped;
+    }
     // The costmap keeps the grown footprint off every object: the margin is half the growth.
     const double margin = 0.5 * params.freespace_planner.vehicle_shape_margin;
     const Selection sel = select_candidate(fallback, 1e-6);  // any clearance: no contact
-    result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, sel.outcome});
+    result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, sel.outcome, sel.detail});
     if (sel.chosen != nullptr) {
       accept(*sel.chosen, PlannerType::kFreespace);
       publish_checked(result, checker, margin, params);
@@ -409,9 +419,11 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const Deadline&
   result.outcome = PlanningResult::Outcome::kNoPath;
   result.path = make_stop_path(request);
   result.path.reasons = no_path_reasons(result.evaluation_table);
-  if (result.timed_out) {
+  result.timed_out = result.stopped == StopReason::kDeadline;
+  if (result.stopped != StopReason::kNone) {
     std::ostringstream os;
-    os << "planning deadline exceeded after " << result.evaluation_table.size() << " attempts";
+    os << (result.timed_out ? "planning deadline exceeded" : "planning cancelled") << " after "
+       << result.evaluation_table.size() << " attempts";
     result.stop_reason = os.str();
     result.path.reasons.push_back(result.stop_reason);
   } else if (planners.empty()) {

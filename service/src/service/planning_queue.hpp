@@ -28,8 +28,8 @@ struct PlanningJob {
   // The vehicle's acceptance number (VehicleRegistry): a result is published only if no newer
   // request of the vehicle was accepted meanwhile.
   std::uint64_t sequence{0};
-  // Set when a newer request of the vehicle arrives or the service stops; the search's Deadline
-  // watches it.
+  // Set when a newer request of the vehicle arrives or the service stops; the search's
+  // StopCondition watches it.
   std::shared_ptr<std::atomic<bool>> cancel;
   std::chrono::steady_clock::time_point accepted_at;
 };

@@ -189,13 +189,13 @@ void PulloutService::run_job(PlanningJob& job) {
   const PullOutRequest& request = job.request;
   if (stopping_ || job.cancel->load()) return;  // superseded or shutting down before it started
   const double budget_ms = effective_deadline_ms(request.deadline_ms);
-  const Deadline deadline = Deadline::after_ms(budget_ms, job.cancel.get());
+  const StopCondition stop = StopCondition::after_ms(budget_ms).with_cancel(job.cancel.get());
   const double waited_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - job.accepted_at).count();
 
   PlanningResult result;
   try {
-    result = planner_.plan(request, deadline);
+    result = planner_.plan(request, stop);
   } catch (const std::exception& e) {
     spdlog::error("vehicle '{}' request {}: planner failed: {}", request.vehicle_id, request.request_id, e.what());
     if (!stopping_) registry_.on_search_failed(job, e.what());
@@ -210,8 +210,16 @@ void PulloutService::run_job(PlanningJob& job) {
   } else {
     spdlog::info(
         "vehicle '{}' request {}: {}{}, {:.1f} ms: {}", request.vehicle_id, request.request_id,
-        outcome_name(result.outcome), result.timed_out ? " (deadline)" : "", result.planning_time_ms,
+        outcome_name(result.outcome),
+        result.stopped == StopReason::kNone ? ""
+        : result.timed_out                  ? " (deadline)"
+                                            : " (cancelled)",
+        result.planning_time_ms,
         result.outcome == PlanningResult::Outcome::kRejected ? format_issues(result.issues) : result.stop_reason);
+    for (const PlannerAttempt& a : result.evaluation_table) {
+      spdlog::debug("vehicle '{}' request {}:   {} margin {:.2f} m, backward {:.2f} m: {}", request.vehicle_id,
+                    request.request_id, to_string(a.planner), a.margin_m, a.backward_distance_m, describe(a));
+    }
   }
 }
 

@@ -24,6 +24,11 @@ msg::PullOutPath to_msg(const PullOutPath& in);
 PullOutPath from_msg(const msg::PullOutPath& in);
 
 msg::PullOutStatus to_msg(const PullOutStatus& in);
+// Checks the enumerations a receiver acts on: an evaluation-table outcome outside the IDL's
+// AttemptOutcome is reported as "evaluation_table[i].outcome" (the row keeps kNoPath and the raw
+// value in its detail). Other enumerators map leniently to their neutral value.
+PullOutStatus from_msg(const msg::PullOutStatus& in, std::vector<RequestIssue>& issues);
+// The same, the issues dropped.
 PullOutStatus from_msg(const msg::PullOutStatus& in);
 
 msg::ExecutionProgress to_msg(const ExecutionProgress& in);

@@ -18,9 +18,10 @@
 //    (not exactly on the end pose) and continued on the road centerline; unlike Autoware, one
 //    velocity/acceleration pair per partial path.
 //
-// Failure modes are values: PlannerCandidates::failure names the search's status ("start
-// occupied", "timeout", ...). The search budget is freespace_planner.time_limit, cut short by the
-// deadline.
+// Failure modes are values: PlannerCandidates::failure is the search's status as an attempt
+// outcome (attempt_outcome) with the end pose in the detail. The search budget is
+// freespace_planner.time_limit (StopReason::kBudget), added to the caller's stop condition: the
+// deadline and cancellation end it too.
 #pragma once
 
 #include <string>
@@ -39,7 +40,7 @@ class FreespacePullOut : public PullOutPlanner {
   PlannerType type() const override { return PlannerType::kFreespace; }
   // One candidate at most. Plans from the current pose only (context.ego): a backward start
   // candidate gets a failure, the search itself reverses where needed.
-  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const Deadline& deadline) const override;
+  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const StopCondition& stop) const override;
 
  private:
   FreespaceParameters parameters_;
@@ -66,13 +67,20 @@ struct SplitPath {
 };
 SplitPath split_at_cusps(const std::vector<Waypoint>& waypoints, double velocity);
 
-// A pure freespace problem (no lanes): from start straight to goal on the costmap.
+// The attempt outcome of a search status: start occupied -> kStartInvalid, goal occupied ->
+// kGoalInvalid, timeout, cancelled, node limit and no path -> the same.
+AttemptOutcome attempt_outcome(HybridAStarResult::Status status);
+
+// A pure freespace problem (no lanes): from start straight to goal on the costmap, within
+// `stop` and freespace_planner.time_limit.
 struct FreespaceGoalResult {
   HybridAStarResult::Status status{HybridAStarResult::Status::kNoPath};
-  PullOutPath path;  // found: partial paths to the goal (end_pose = goal)
+  StopReason stopped{StopReason::kNone};  // why the search was cut short, if it was
+  std::size_t expansions{0};              // search work done (hybrid A* expansions)
+  PullOutPath path;                       // found: partial paths to the goal (end_pose = goal)
 };
 FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const VehicleInfo& vehicle,
                                            const FreespaceParameters& parameters, const Pose2& start, const Pose2& goal,
-                                           const Deadline& deadline);
+                                           const StopCondition& stop);
 
 }  // namespace pullout

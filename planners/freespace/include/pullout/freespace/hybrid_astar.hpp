@@ -34,8 +34,9 @@
 // stretch it proves free. So a returned path is collision-free at every point, not only at its
 // samples, and a motion is refused only if it passes within an eighth of a cell of an obstacle.
 //
-// Failure modes are values (Status), never exceptions. The deadline is checked between
-// expansions; the search returns kTimeout promptly after it expires.
+// Failure modes are values (Status), never exceptions. The stop condition is checked before the
+// first expansion and every few expansions after it; the search returns kTimeout (deadline or
+// budget) or kCancelled promptly once it says stop. More than max_nodes nodes give kNodeLimit.
 //
 // Thread safety: plan() is const and may run concurrently (all search state is local).
 #pragma once
@@ -46,7 +47,7 @@
 
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/model/types.hpp"
-#include "pullout/search/deadline.hpp"
+#include "pullout/search/stop_condition.hpp"
 
 namespace pullout {
 
@@ -68,7 +69,7 @@ struct HybridAStarConfig {
   double longitudinal_goal_range{2.0};  // [m]
   double lateral_goal_range{0.5};       // [m]
   double angle_goal_range{0.10472};     // [rad] (6 deg)
-  std::size_t max_nodes{4000000};       // memory bound: no path when exceeded
+  std::size_t max_nodes{4000000};       // memory bound: Status::kNodeLimit when exceeded
   double waypoint_interval{0.25};       // [m] spacing of the returned waypoints (at most)
   // Debugging aid: when set, every expanded pose is appended here, in expansion order (a picture
   // of where the search spent its time). Not thread safe: one plan() per vector.
@@ -83,10 +84,11 @@ struct Waypoint {
 };
 
 struct HybridAStarResult {
-  enum class Status { kSuccess, kStartOccupied, kGoalOccupied, kTimeout, kNoPath };
+  enum class Status { kSuccess, kStartOccupied, kGoalOccupied, kTimeout, kCancelled, kNodeLimit, kNoPath };
   Status status{Status::kNoPath};
-  std::vector<Waypoint> waypoints;  // start ... goal (or the pose in the goal region)
-  double length{0.0};               // [m] driven, both directions
+  StopReason stopped{StopReason::kNone};  // kTimeout / kCancelled: the reason the stop condition gave
+  std::vector<Waypoint> waypoints;        // start ... goal (or the pose in the goal region)
+  double length{0.0};                     // [m] driven, both directions
   std::size_t expansions{0};
   std::size_t nodes{0};
   std::size_t shots{0};            // Reeds-Shepp analytic expansions tried
@@ -100,7 +102,7 @@ class HybridAStar {
   // The checker (and its costmap) must outlive the planner.
   HybridAStar(const GridCollisionChecker& checker, const HybridAStarConfig& config);
 
-  HybridAStarResult plan(const Pose2& start, const Pose2& goal, const Deadline& deadline) const;
+  HybridAStarResult plan(const Pose2& start, const Pose2& goal, const StopCondition& stop) const;
 
   const HybridAStarConfig& config() const { return config_; }
 

@@ -19,7 +19,7 @@ namespace pullout {
 class ClothoidPullOut final : public PullOutPlanner {
  public:
   PlannerType type() const override { return PlannerType::kClothoid; }
-  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const Deadline& deadline) const override;
+  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const StopCondition& stop) const override;
 };
 
 }  // namespace pullout

@@ -26,7 +26,7 @@ namespace pullout {
 class GeometricPullOut final : public PullOutPlanner {
  public:
   PlannerType type() const override { return PlannerType::kGeometric; }
-  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const Deadline& deadline) const override;
+  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const StopCondition& stop) const override;
 };
 
 }  // namespace pullout

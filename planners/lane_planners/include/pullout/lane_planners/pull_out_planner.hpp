@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,7 +18,7 @@
 #include "pullout/lane_planners/lane_planner_parameters.hpp"
 #include "pullout/lanes/lane_world.hpp"
 #include "pullout/model/types.hpp"
-#include "pullout/search/deadline.hpp"
+#include "pullout/search/stop_condition.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace pullout {
@@ -39,9 +40,16 @@ struct PlanningContext {
   const std::vector<Polygon>* obstacle_polygons{nullptr};
 };
 
+// Why an attempt or a candidate failed: the typed outcome and a detail for people ("object 7",
+// "no two-arc path to the centerline"; may be empty).
+struct Failure {
+  AttemptOutcome outcome{AttemptOutcome::kNoPath};
+  std::string detail;
+};
+
 struct PathCandidate {
-  // Why this candidate cannot be used at any margin ("lane departure", ...); empty when usable.
-  std::string rejection;
+  // Why this candidate cannot be used at any margin (lane departure, contact, ...); none when usable.
+  std::optional<Failure> rejection;
   // Smallest distance [m] from the footprint to a static obstacle over the collision-checked
   // section; +inf when no obstacle is within the context's clearance_horizon.
   double clearance{std::numeric_limits<double>::infinity()};
@@ -53,27 +61,36 @@ struct PathCandidate {
 
 struct PlannerCandidates {
   std::vector<PathCandidate> candidates;  // in order of preference
-  std::string failure;                    // why there is no candidate at all, if so
-  bool timed_out{false};
+  std::optional<Failure> failure;         // why there is no candidate at all, if known
+  // Why the planner stopped before it was done (kNone: it was not cut short). kBudget is the
+  // planner's own budget: the caller's deadline and cancellation still hold.
+  StopReason stopped{StopReason::kNone};
 };
 
 class PullOutPlanner {
  public:
   virtual ~PullOutPlanner() = default;
   virtual PlannerType type() const = 0;
-  // Candidates from `start`, each checked. Must return promptly once the deadline has expired
-  // (timed_out = true). Never throws for geometric failure.
+  // Candidates from `start`, each checked. Must check `stop` between candidates and return
+  // promptly once it says stop (PlannerCandidates::stopped set to its reason). Never throws for
+  // geometric failure.
   virtual PlannerCandidates plan(const PlanningContext& context, const Pose2& start,
-                                 const Deadline& deadline) const = 0;
+                                 const StopCondition& stop) const = 0;
 };
 
 // The first candidate usable at `margin` (nullptr if none), and the evaluation-table outcome:
-// "success", or the reasons with their counts ("collision with object 7 (4/4 candidates)").
+// kSuccess; or, when none is usable, the outcome of most candidates (the first one's on a tie;
+// kTimeout / kCancelled when the planner was cut short) with every reason and its count in the
+// detail ("object 7 (3/4 candidates); lane_departure (1/4 candidates)").
 struct Selection {
   const PathCandidate* chosen{nullptr};
-  std::string outcome;
+  AttemptOutcome outcome{AttemptOutcome::kNoPath};
+  std::string detail;
 };
 Selection select_candidate(const PlannerCandidates& candidates, double margin);
+
+// The attempt outcome of a search stopped for `reason` (kTimeout, or kCancelled), and its detail.
+Failure stopped_failure(StopReason reason);
 
 // ---- checks shared by the planners ----
 
@@ -87,8 +104,9 @@ ObjectChecker::Clearance section_clearance(const PlanningContext& context, const
                                            std::size_t first, std::size_t last);
 
 // Fills candidate.rejection / clearance from the standard checks: lane departure over
-// [0, departure_last] with the footprint expanded by `expansion` (when `check_lanes`), clearance
-// over [0, section_last], and no contact at all over (section_last, contact_last].
+// [0, departure_last] with the footprint expanded by `expansion` (when `check_lanes`; rejection
+// kLaneDeparture), clearance over [0, section_last], and no contact at all over
+// (section_last, contact_last] (rejection kCollision, detail naming the object).
 struct CandidateChecks {
   bool check_lanes{true};
   double expansion{0.0};

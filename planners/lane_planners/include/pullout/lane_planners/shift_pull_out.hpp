@@ -75,7 +75,7 @@ std::vector<double> lateral_acc_samples(const LanePlannerParameters& parameters)
 class ShiftPullOut final : public PullOutPlanner {
  public:
   PlannerType type() const override { return PlannerType::kShift; }
-  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const Deadline& deadline) const override;
+  PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const StopCondition& stop) const override;
 };
 
 }  // namespace pullout

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <utility>
 
@@ -68,6 +69,18 @@ inline constexpr std::array<std::pair<LaneSubtype, const char*>, 2> kSubtypeName
     {LaneSubtype::kRoad, "road"},
     {LaneSubtype::kRoadShoulder, "road_shoulder"},
 }};
+inline constexpr std::array<std::pair<AttemptOutcome, const char*>, 10> kOutcomeNames{{
+    {AttemptOutcome::kSuccess, "success"},
+    {AttemptOutcome::kCollision, "collision"},
+    {AttemptOutcome::kLaneDeparture, "lane_departure"},
+    {AttemptOutcome::kNoGeometry, "no_geometry"},
+    {AttemptOutcome::kStartInvalid, "start_invalid"},
+    {AttemptOutcome::kGoalInvalid, "goal_invalid"},
+    {AttemptOutcome::kTimeout, "timeout"},
+    {AttemptOutcome::kCancelled, "cancelled"},
+    {AttemptOutcome::kNodeLimit, "node_limit"},
+    {AttemptOutcome::kNoPath, "no_path"},
+}};
 }  // namespace detail
 
 inline const char* to_string(PlannerType v) { return detail::name_of(detail::kPlannerNames, v); }
@@ -76,6 +89,14 @@ inline const char* to_string(ObjectClass v) { return detail::name_of(detail::kCl
 inline const char* to_string(TurnSignal v) { return detail::name_of(detail::kTurnSignalNames, v); }
 inline const char* to_string(SearchPolicy v) { return detail::name_of(detail::kPolicyNames, v); }
 inline const char* to_string(LaneSubtype v) { return detail::name_of(detail::kSubtypeNames, v); }
+inline const char* to_string(AttemptOutcome v) { return detail::name_of(detail::kOutcomeNames, v); }
+
+// "collision: object 7 (4/4 candidates)", or the outcome's name alone when there is no detail.
+inline std::string describe(const PlannerAttempt& a) {
+  std::string out = to_string(a.outcome);
+  if (!a.detail.empty()) out += ": " + a.detail;
+  return out;
+}
 
 inline std::optional<PlannerType> planner_type_from_string(std::string_view n) {
   return detail::value_of(detail::kPlannerNames, n);

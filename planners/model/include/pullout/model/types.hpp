@@ -133,13 +133,30 @@ struct TerminalVelocityAccel {
 
 enum class TurnSignal : std::uint8_t { kNone = 0, kLeft = 1, kRight = 2 };
 
+// What came of one attempt, as a value (names: model/names.hpp). The values are those of the
+// IDL's AttemptOutcome, in the same order.
+enum class AttemptOutcome : std::uint8_t {
+  kSuccess = 0,        // a usable path
+  kCollision = 1,      // too close to (or touching) a static obstacle at this margin
+  kLaneDeparture = 2,  // the footprint leaves the lanes
+  kNoGeometry = 3,     // the planner's geometry has no solution (no two-arc path, road too short)
+  kStartInvalid = 4,   // the start pose cannot be used (off the road, heading, occupied, boxed in)
+  kGoalInvalid = 5,    // no usable end pose (occupied, none on the road ahead)
+  kTimeout = 6,        // the planning deadline or the planner's own time budget ran out
+  kCancelled = 7,      // the search was cancelled (newer request, shutdown)
+  kNodeLimit = 8,      // the search's node budget ran out (hybrid A* max_nodes)
+  kNoPath = 9,         // the search was complete and found nothing
+};
+
 // One row of the planner evaluation table: one attempt of one planner at one margin from one start
-// candidate, and what came of it ("success", "collision", "lane departure", ...).
+// candidate (planner kNone: a start candidate that was skipped), what came of it, and a detail for
+// people (the object, "4/4 candidates", ...; may be empty).
 struct PlannerAttempt {
   PlannerType planner{PlannerType::kNone};
   double margin_m{0.0};
   double backward_distance_m{0.0};
-  std::string outcome;
+  AttemptOutcome outcome{AttemptOutcome::kNoPath};
+  std::string detail;
 };
 
 struct PullOutPath {

@@ -11,8 +11,9 @@
 // Thread safety: StartPlanner is immutable after construction; plan() may be called concurrently
 // from several threads. Failure modes are values, never exceptions: an invalid request gives
 // Outcome::kRejected with one issue per problem (naming the field), "no path" gives
-// Outcome::kNoPath with a stop path and the reasons, and an expired deadline gives kNoPath with
-// timed_out = true.
+// Outcome::kNoPath with a stop path and the reasons, and a search cut short by the stop condition
+// gives kNoPath with `stopped` set (timed_out = true for the deadline). Each evaluation-table row
+// carries a typed AttemptOutcome and a detail.
 //
 // Lanes come either inline (request.lanes) or from the Lanelet2 map given at construction:
 // request.route_lanelet_ids then names the road lanelets to pull out onto, and the pipeline plans
@@ -27,7 +28,7 @@
 #include "pullout/model/types.hpp"
 #include "pullout/pipeline/parameters.hpp"
 #include "pullout/pipeline/published_path.hpp"
-#include "pullout/search/deadline.hpp"
+#include "pullout/search/stop_condition.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace pullout {
@@ -56,7 +57,10 @@ struct PlanningResult {
   // kFound: how the published path ends (finish_published_path): where it stops before an object
   // beyond the end pose, or that it is clear; `path_end.note` is also the last of path.reasons.
   PublishedPathEnd path_end;
-  bool timed_out{false};
+  // Why the search was cut short before it was done: kDeadline or kCancelled (the caller's stop
+  // condition; a planner's own budget only ends that planner's attempt), kNone otherwise.
+  StopReason stopped{StopReason::kNone};
+  bool timed_out{false};  // stopped == kDeadline
   double planning_time_ms{0.0};
   // kFound and kNoPath: what was planned on (lanes empty for a grid-only request). Null: kRejected.
   std::shared_ptr<const PlannedWorld> world;
@@ -69,9 +73,10 @@ class StartPlanner {
   StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits = {},
                std::shared_ptr<const LaneletMap> map = nullptr);
 
-  // Plans for one request. Applies the request's overrides (search_priority, search_policy) to
-  // a copy of the parameters. Never throws for bad input.
-  PlanningResult plan(const PullOutRequest& request, const Deadline& deadline) const;
+  // Plans for one request within `stop` (checked before every attempt and inside every search).
+  // Applies the request's overrides (search_priority, search_policy) to a copy of the parameters.
+  // Never throws for bad input.
+  PlanningResult plan(const PullOutRequest& request, const StopCondition& stop) const;
 
   // Only the validation step of plan(): every problem of the request, empty when valid.
   std::vector<RequestIssue> validate(const PullOutRequest& request) const;
@@ -84,7 +89,7 @@ class StartPlanner {
  private:
   bool grid_only_allowed() const;
   // A request with a grid and no lanes: hybrid A* straight to the goal pose.
-  PlanningResult plan_grid_only(const PullOutRequest& request, const Deadline& deadline) const;
+  PlanningResult plan_grid_only(const PullOutRequest& request, const StopCondition& stop) const;
 
   VehicleInfo vehicle_;
   StartPlannerParameters parameters_;
