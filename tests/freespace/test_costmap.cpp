@@ -121,6 +121,45 @@ TEST(Costmap, PolygonsRasteriseConservatively) {
   EXPECT_TRUE(m.occupied(i, j));  // [6.0, 6.25] x [3.0, 3.25] holds the box corner (6.1, 3.1)
 }
 
+TEST(Costmap, PolygonsOfAnySizeRasterise) {
+  // Coordinates far beyond the range of int cell indices: clamped to the grid, not converted.
+  Costmap map = empty_map(10, 10, 1.0);
+  map.add_obstacles({{{1e300, 1e300}, {1.1e300, 1e300}, {1.1e300, 1.1e300}}});
+  EXPECT_EQ(map.occupied_count(), 0u);  // far outside: nothing
+  // A wall x in [2.5, 3.5] from y = -1e300 to 1e300: columns 2 and 3 of every row.
+  map.add_obstacles({{{2.5, -1e300}, {3.5, -1e300}, {3.5, 1e300}, {2.5, 1e300}}});
+  EXPECT_EQ(map.occupied_count(), 20u);
+  for (int j = 0; j < 10; ++j) {
+    EXPECT_TRUE(map.occupied(2, j) && map.occupied(3, j)) << j;
+    EXPECT_FALSE(map.occupied(1, j) || map.occupied(4, j)) << j;
+  }
+  map.add_obstacles({{{-1e300, -1e300}, {1e300, -1e300}, {1e300, 1e300}, {-1e300, 1e300}}});
+  EXPECT_EQ(map.occupied_count(), 100u);
+
+  // A drivable area far larger than the extent: every cell free (no outline given) except rows 4
+  // and 5, which an obstacle band y in [4.5, 5.5] as wide as the drivable area blocks.
+  Aabb extent;
+  extent.extend({0, 0});
+  extent.extend({10, 10});
+  const Costmap lot =
+      Costmap::from_polygons(extent, 1.0, {{{-1e300, -1e300}, {1e300, -1e300}, {1e300, 1e300}, {-1e300, 1e300}}}, {},
+                             {{{-1e300, 4.5}, {1e300, 4.5}, {1e300, 5.5}, {-1e300, 5.5}}});
+  EXPECT_EQ(lot.width(), 10);
+  EXPECT_EQ(lot.height(), 10);
+  EXPECT_EQ(lot.occupied_count(), 20u);
+  EXPECT_TRUE(lot.occupied(0, 4) && lot.occupied(9, 5));
+  EXPECT_FALSE(lot.occupied(0, 3) || lot.occupied(9, 6));
+  // An extent wider than 16384 cells is cut there; an inverted one gives one cell.
+  Aabb wide;
+  wide.extend({0, 0});
+  wide.extend({1e300, 2});
+  EXPECT_EQ(Costmap::from_polygons(wide, 1.0, {}, {}, {}).width(), 16384);
+  Aabb inverted;
+  inverted.min = {1e300, 0.0};
+  inverted.max = {0.0, 2.0};
+  EXPECT_EQ(Costmap::from_polygons(inverted, 1.0, {}, {}, {}).width(), 1);
+}
+
 // The footprint (4.6 m x 1.9 m around base_link) against one occupied cell: a few millimetres
 // into the cell is a collision, a few millimetres short of it is not, head-on and corner-first.
 TEST(GridCollisionChecker, ExactAtTheMillimetre) {

@@ -46,6 +46,7 @@ std::string ExitResult::describe() const {
   std::ostringstream os;
   if (exited) {
     os << "exited with status " << exit_code;
+    if (exit_code == kSanitizerExitCode) os << " (a sanitizer report: see its stderr)";
   } else if (signal != 0) {
     os << "killed by " << signal_name(signal);
   } else {

@@ -26,6 +26,11 @@ namespace pullout::integration {
 
 using Millis = std::chrono::milliseconds;
 
+// The exit status of a process that a sanitizer stopped (ASAN_OPTIONS and UBSAN_OPTIONS exitcode,
+// set by scripts/test-sanitize): no pullout program exits with it, so a report is never taken for
+// an expected failure (a bad config exits with 1, as do the sanitizers by default).
+constexpr int kSanitizerExitCode = 66;
+
 // How a child ended.
 struct ExitResult {
   bool exited{false};  // normal exit: exit_code is valid

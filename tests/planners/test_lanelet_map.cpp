@@ -144,6 +144,20 @@ TEST(LaneletMap, SpatialQueriesMatchBruteForce) {
   }
 }
 
+TEST(LaneletMap, SpatialQueriesAtAnyCoordinates) {
+  // A lanelet x in [-10, 0] (negative cell indices), queried near and very far away.
+  const auto map = parse_lanelet_map(osm(node(1, -10, 1.5) + node(2, 0, 1.5) + node(3, -10, -1.5) + node(4, 0, -1.5) +
+                                         way(10, {1, 2}) + way(11, {3, 4}) + lanelet(7, 10, 11)),
+                                     "test.osm");
+  EXPECT_EQ(ids_of(*map, map->lanelets_containing({-5.0, 0.0})), std::vector<std::int64_t>{7});
+  EXPECT_TRUE(map->lanelets_containing({5.0, 0.0}).empty());
+  EXPECT_EQ(ids_of(*map, map->lanelets_near({-12.0, 0.0}, 2.5)), std::vector<std::int64_t>{7});
+  for (const Point2& p : {Point2{1e300, 0.0}, Point2{-1e300, 0.0}, Point2{-5.0, 1e300}, Point2{-1e300, -1e300}}) {
+    EXPECT_TRUE(map->lanelets_containing(p).empty()) << p.x << ", " << p.y;
+    EXPECT_TRUE(map->lanelets_near(p, 10.0).empty()) << p.x << ", " << p.y;
+  }
+}
+
 TEST(LaneletMap, ConvertsRoadAndShoulderLanelets) {
   const auto map = load_lanelet_map(kOwnMap);
   const auto lane = to_lane(by_id(*map, 201));

@@ -179,6 +179,30 @@ TEST(PreventingRearVehicle, GapToThePassingSideBound) {
   EXPECT_TRUE(monitor({}, straight_path(3.25)).preventing_rear_vehicle({{20.0, 3.25, 0.0}, {25.0, 0.5, 0.0}}));
 }
 
+TEST(PreventingRearVehicle, TheNearestCarBehindAndItsWidthDecide) {
+  // The ego at y = 1.0 leaves 1.802 m to the road's right bound (see above); margin 0.5 m.
+  Object wide = car(1, 0.0, 0.0, 10.0);  // 1.9 + 0.5 > 1.802: could not pass
+  Object narrow = car(2, 0.0, 0.0, 10.0);
+  narrow.width_m = 1.0;  // 1.5 <= 1.802: could pass
+  const PullOutPath path = straight_path(1.0);
+  const std::vector<Pose2> at = {{20.0, 1.0, 0.0}};
+  // Only the nearest car behind counts: the other one is farther back.
+  wide.pose.x = 10.0;
+  narrow.pose.x = -10.0;
+  EXPECT_TRUE(monitor({narrow, wide}, path).preventing_rear_vehicle(at));
+  wide.pose.x = -10.0;
+  narrow.pose.x = 10.0;
+  EXPECT_FALSE(monitor({wide, narrow}, path).preventing_rear_vehicle(at));
+  // A footprint polygon (object frame) gives the width instead of width_m: 2.4 m across.
+  Object shaped = narrow;
+  shaped.polygon = {{-2.0, -1.2}, {2.0, -1.2}, {2.0, 1.2}, {-2.0, 1.2}};
+  EXPECT_TRUE(monitor({shaped}, path).preventing_rear_vehicle(at));
+  // 0.8 m across although width_m says 3.0.
+  shaped.width_m = 3.0;
+  shaped.polygon = {{-2.0, -0.4}, {2.0, -0.4}, {2.0, 0.4}, {-2.0, 0.4}};
+  EXPECT_FALSE(monitor({shaped}, path).preventing_rear_vehicle(at));
+}
+
 TEST(SafetyMonitor, HoldsForAFastCarFromBehind) {
   auto m = monitor({car(1, -20.0, 0.0, 10.0)}, straight_path(3.25));
   const SafetyVerdict v = m.evaluate({10.0, 3.25, 0.0}, 0.0, 0, false);

@@ -266,6 +266,29 @@ TEST(Scenario, GridFromObstacleShapes) {
   EXPECT_TRUE(s.request.lanes.empty());
 }
 
+TEST(Scenario, GridObstacleOutsideTheGridIsAnError) {
+  // 1e300 (or a typo) would otherwise be dropped silently, leaving a free grid and a path.
+  const auto p = problems_of(std::string(kPoses) +
+                             "grid:\n  resolution: 0.5\n  origin: {x: -1.0, y: -2.0}\n  size: [10, 5]\n"
+                             "  obstacles:\n    - {x: 1e300, y: 0.0, length: 1.0, width: 1.0}\n"
+                             "    - {x: 2.0, y: 0.0, length: 1.0, width: 1.0}\n"
+                             "    - {polygon: [[20, 0], [21, 0], [21, 1]]}\n"
+                             "    - {x: 9.4, y: 3.4, length: 1.0, width: 1.0}\n");
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles[0] (at x 1e+300, y 0): lies entirely outside the grid")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles[2].polygon: lies entirely outside the grid")) << dump(p);
+  EXPECT_EQ(p.size(), 2u) << dump(p);  // [1] inside, [3] reaches in from the far corner
+}
+
+TEST(Scenario, GridSizeOfAnyMagnitudeIsChecked) {
+  for (const char* size : {"[1e300, 5]", "[10, -1e300]", "[1e-300, 5]"}) {
+    const auto p = problems_of(std::string(kPoses) + "grid:\n  resolution: 0.5\n  size: " + size + "\n");
+    EXPECT_TRUE(any_starts_with(p, "grid.size: must give 1 to")) << size << ": " << dump(p);
+  }
+  // No obstacles and no size at all: a problem, not an exception.
+  const auto p = problems_of(std::string(kPoses) + "grid:\n  resolution: 0.5\n");
+  EXPECT_TRUE(any_starts_with(p, "grid.size: required")) << dump(p);
+}
+
 TEST(Scenario, GridFromAMapServerImage) {
   // A 4 x 3 P2 image: black (occupied), white (free), grey (unknown); the top row first.
   const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_map_" + std::to_string(::getpid()));

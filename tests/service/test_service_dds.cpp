@@ -73,23 +73,21 @@ class ServiceChild {
     ASSERT_EQ(posix_spawn(&pid_, kServiceBinary.c_str(), nullptr, nullptr, argv.data(), environ), 0);
   }
 
-  // SIGTERM, then the exit status (or -1 if it had to be killed).
+  // SIGTERM, then the exit status (or -1 if it had to be killed or was killed by a signal).
+  // Idempotent: once the child is reaped (here or by running()) its exit status is returned.
   int stop(std::chrono::milliseconds timeout = std::chrono::milliseconds(5000)) {
-    if (pid_ <= 0) return -1;
+    if (pid_ <= 0) return exit_code_;
     ::kill(pid_, SIGTERM);
     const auto until = Clock::now() + timeout;
     int status = 0;
     while (Clock::now() < until) {
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = 0;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-      }
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) return reaped(status);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     ::kill(pid_, SIGKILL);
     ::waitpid(pid_, &status, 0);
     pid_ = 0;
-    return -1;
+    return exit_code_;
   }
 
   pid_t pid() const { return pid_; }
@@ -112,14 +110,21 @@ class ServiceChild {
     if (pid_ <= 0) return false;
     int status = 0;
     if (::waitpid(pid_, &status, WNOHANG) == 0) return true;
-    pid_ = 0;  // exited (and reaped): never signal this pid again
+    reaped(status);  // exited: never signal this pid again
     return false;
   }
 
   ~ServiceChild() { stop(std::chrono::milliseconds(2000)); }
 
  private:
+  int reaped(int status) {
+    pid_ = 0;
+    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return exit_code_;
+  }
+
   pid_t pid_{0};
+  int exit_code_{-1};
 };
 
 // ---- a minimal client --------------------------------------------------------------------------
@@ -381,6 +386,9 @@ class ServiceDds : public ::testing::Test {
   }
   static void TearDownTestSuite() {
     client_.reset();
+    // A service that did not exit cleanly (a crash, a sanitizer report) fails the test it ran in.
+    const int exit_code = service_->stop();
+    if (exit_code != 0) ADD_FAILURE() << "pullout_service exit status " << exit_code << " (-1: killed by a signal)";
     service_.reset();
     domain_.reset();
   }

@@ -42,6 +42,17 @@ void distance_transform_1d(const double* f, int n, double* d, int* v, double* z)
   }
 }
 
+// v (an integral value: a floor or ceil) as an int clamped to [lo, hi]. The comparison comes
+// before the conversion, so v may be of any size; NaN gives lo.
+int clamped_int(double v, int lo, int hi) {
+  if (!(v >= lo)) return lo;
+  if (v >= hi) return hi;
+  return static_cast<int>(v);
+}
+
+// The largest side of a costmap made by from_polygons [cells].
+constexpr int kMaxSideCells = 1 << 14;
+
 }  // namespace
 
 bool strip_extent(const Vec2* vertices, std::size_t count, double y0, double y1, double& x_min, double& x_max) {
@@ -89,8 +100,8 @@ Costmap Costmap::from_occupancy_grid(const OccupancyGrid& grid, int obstacle_thr
 Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std::vector<Polygon>& drivable,
                                const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
                                const std::vector<Polygon>& obstacles) {
-  const int w = std::max(1, static_cast<int>(std::ceil((extent.max.x() - extent.min.x()) / resolution)));
-  const int h = std::max(1, static_cast<int>(std::ceil((extent.max.y() - extent.min.y()) / resolution)));
+  const int w = clamped_int(std::ceil((extent.max.x() - extent.min.x()) / resolution), 1, kMaxSideCells);
+  const int h = clamped_int(std::ceil((extent.max.y() - extent.min.y()) / resolution), 1, kMaxSideCells);
   const Pose2 origin{extent.min.x(), extent.min.y(), 0.0};
   std::vector<std::uint8_t> occ(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 1);
 
@@ -106,8 +117,8 @@ Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std:
       const double lo = std::min(a.y(), b.y());
       const double hi = std::max(a.y(), b.y());
       // Rows j whose centre j + 0.5 is in [lo, hi): half-open, so a vertex is counted once.
-      const int j0 = std::max(0, static_cast<int>(std::ceil(lo - 0.5)));
-      const int j1 = std::min(h - 1, static_cast<int>(std::ceil(hi - 0.5)) - 1);
+      const int j0 = clamped_int(std::ceil(lo - 0.5), 0, h);
+      const int j1 = clamped_int(std::ceil(hi - 0.5) - 1.0, -1, h - 1);
       for (int j = j0; j <= j1; ++j) {
         const double y = j + 0.5;
         crossings[static_cast<std::size_t>(j)].push_back(a.x() + (y - a.y()) / (b.y() - a.y()) * (b.x() - a.x()));
@@ -118,8 +129,8 @@ Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std:
       std::sort(xs.begin(), xs.end());
       for (std::size_t k = 0; k + 1 < xs.size(); k += 2) {
         // Columns whose centre i + 0.5 lies in [xs[k], xs[k+1]].
-        const int i0 = std::max(0, static_cast<int>(std::ceil(xs[k] - 0.5)));
-        const int i1 = std::min(w - 1, static_cast<int>(std::floor(xs[k + 1] - 0.5)));
+        const int i0 = clamped_int(std::ceil(xs[k] - 0.5), 0, w);
+        const int i1 = clamped_int(std::floor(xs[k + 1] - 0.5), -1, w - 1);
         for (int i = i0; i <= i1; ++i) occ[static_cast<std::size_t>(j) * w + i] = 0;
       }
     }
@@ -149,14 +160,14 @@ void Costmap::add_obstacles(const std::vector<Polygon>& polygons) {
     // A cell is marked when the polygon meets its interior: a polygon that ends exactly on a
     // cell boundary (a wall 0.4 m thick on 0.2 m cells) does not mark the next cell.
     constexpr double kInterior = 1e-9;  // [cells]
-    const int j0 = std::max(0, static_cast<int>(std::floor(y_lo + kInterior)));
-    const int j1 = std::min(height_ - 1, static_cast<int>(std::floor(y_hi - kInterior)));
+    const int j0 = clamped_int(std::floor(y_lo + kInterior), 0, height_);
+    const int j1 = clamped_int(std::floor(y_hi - kInterior), -1, height_ - 1);
     for (int j = j0; j <= j1; ++j) {
       double x0 = 0.0;
       double x1 = 0.0;
       if (!strip_extent(g.data(), g.size(), j + kInterior, j + 1.0 - kInterior, x0, x1)) continue;
-      const int i0 = std::max(0, static_cast<int>(std::floor(x0 + kInterior)));
-      const int i1 = std::min(width_ - 1, static_cast<int>(std::floor(x1 - kInterior)));
+      const int i0 = clamped_int(std::floor(x0 + kInterior), 0, width_);
+      const int i1 = clamped_int(std::floor(x1 - kInterior), -1, width_ - 1);
       for (int i = i0; i <= i1; ++i) occupied_[index(i, j)] = 1;
     }
   }
@@ -182,8 +193,8 @@ Vec2 Costmap::to_map(const Vec2& g) const {
 void Costmap::cell_of(const Vec2& p_M, int& ix, int& iy) const {
   const Vec2 g = to_grid(p_M);
   // Clamped before the conversion so that far-away points cannot overflow int.
-  ix = static_cast<int>(std::floor(std::clamp(g.x(), -2.0, width_ + 2.0)));
-  iy = static_cast<int>(std::floor(std::clamp(g.y(), -2.0, height_ + 2.0)));
+  ix = clamped_int(std::floor(g.x()), -2, width_ + 2);
+  iy = clamped_int(std::floor(g.y()), -2, height_ + 2);
 }
 
 double Costmap::clearance_lower_bound(const Vec2& p_M) const {

@@ -104,9 +104,11 @@ bool SafetyMonitor::preventing_rear_vehicle(const std::vector<Pose2>& poses) con
 
     // The nearest target behind the ego on the current lane.
     const double s_ego = current_->centerline.project(to_vec(pose)).s;
+    // `rear` points into `candidates`, which must outlive its use below.
+    const std::vector<Object> candidates = targets(pose);
     const Object* rear = nullptr;
     double best = std::numeric_limits<double>::infinity();
-    for (const Object& o : targets(pose)) {
+    for (const Object& o : candidates) {
       const Vec2 p = to_vec(o.pose);
       bool on_current = false;
       for (const std::size_t i : lanes_.lanes_containing(p)) {

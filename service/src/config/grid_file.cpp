@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include "pullout/collision/footprint.hpp"
 #include "pullout/freespace/costmap.hpp"
@@ -185,15 +186,18 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
   }
   const YAML::Node size = r.get("size");
   double w = 0.0, h = 0.0;
-  if (!size.IsSequence() || size.size() != 2) {
+  // A missing key gives an invalid node, on which IsSequence() throws: IsDefined() first.
+  if (!size.IsDefined() || !size.IsSequence() || size.size() != 2) {
     problems.push_back("grid.size: required, [width, height] [m]");
   } else {
     w = yaml_fields::to_double(size[0], "grid.size[0]", problems).value_or(0.0);
     h = yaml_fields::to_double(size[1], "grid.size[1]", problems).value_or(0.0);
   }
   std::vector<Polygon> shapes;
-  const YAML::Node obstacles = r.get("obstacles");
-  if (obstacles.IsDefined() && !obstacles.IsSequence()) problems.push_back("grid.obstacles: expected a list");
+  std::vector<std::string> shape_paths;  // the key path of each shape, for problems
+  const YAML::Node listed = r.get("obstacles");
+  const YAML::Node obstacles = listed.IsDefined() ? listed : YAML::Node(YAML::NodeType::Sequence);
+  if (!obstacles.IsSequence()) problems.push_back("grid.obstacles: expected a list");
   for (std::size_t i = 0; obstacles.IsSequence() && i < obstacles.size(); ++i) {
     const std::string path = yaml_fields::indexed("grid.obstacles", i);
     yaml_fields::MapReader b(obstacles[i], path, problems);
@@ -212,6 +216,7 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
       }
       if (poly.size() < 3) problems.push_back(path + ".polygon: needs at least 3 points");
       shapes.push_back(poly);
+      shape_paths.push_back(path + ".polygon");
     } else {
       Object box;
       b.read("x", box.pose.x);
@@ -222,18 +227,37 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
       b.read("width", box.width_m);
       if (!(box.length_m > 0.0 && box.width_m > 0.0)) problems.push_back(path + ": length and width must be > 0");
       shapes.push_back(object_polygon(box));
+      std::ostringstream where;
+      where << path << " (at x " << box.pose.x << ", y " << box.pose.y << ")";
+      shape_paths.push_back(where.str());
     }
     b.finish();
   }
   r.finish();
   if (problems.size() != before) return false;
-  const int cw = static_cast<int>(std::ceil(w / resolution - 1e-9));
-  const int ch = static_cast<int>(std::ceil(h / resolution - 1e-9));
-  if (cw < 1 || ch < 1 || static_cast<long>(cw) * ch > kMaxCells) {
+  // Cell counts in double: a size of any magnitude is checked before it becomes an int.
+  const double cells_x = std::ceil(w / resolution - 1e-9);
+  const double cells_y = std::ceil(h / resolution - 1e-9);
+  if (!(cells_x >= 1.0 && cells_y >= 1.0 && cells_x * cells_y <= static_cast<double>(kMaxCells))) {
     problems.push_back("grid.size: must give 1 to " + std::to_string(kMaxCells) + " cells");
     return false;
   }
+  const int cw = static_cast<int>(cells_x);
+  const int ch = static_cast<int>(cells_y);
   Costmap raster(origin, resolution, cw, ch, {});
+  // An obstacle that does not reach into the grid cannot be meant (a typo, wrong units, a
+  // coordinate like 1e300): rejected rather than silently dropped.
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    Aabb box;
+    for (const Vec2& p : shapes[k]) box.extend(raster.to_grid(p));
+    const bool meets = box.min.x() <= cw && box.max.x() >= 0.0 && box.min.y() <= ch && box.max.y() >= 0.0;
+    if (!meets) {
+      std::ostringstream os;
+      os << shape_paths[k] << ": lies entirely outside the grid (" << w << " x " << h << " m from its origin)";
+      problems.push_back(os.str());
+    }
+  }
+  if (problems.size() != before) return false;
   raster.add_obstacles(shapes);
   out.resolution_m = resolution;
   out.origin = origin;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "pullout/geometry/grid_cell.hpp"
+
 namespace pullout {
 
 namespace {
@@ -12,6 +14,17 @@ constexpr double kConnectTolerance = 0.1;  // [m] bound end points closer than t
 constexpr double kEdgePieceLength = 0.5;   // [m] lane edges are split into pieces this long
 constexpr double kSharedEdgeProbe = 0.05;  // [m] probe distance outside an edge piece
 constexpr double kCenterlineStep = 0.5;    // [m] sampling of derived centerlines
+// At most this many edge pieces or centerline steps per line: a longer line (over 50 km) gets
+// longer pieces rather than unbounded memory and time.
+constexpr double kMaxPieces = 1e5;
+
+// The number of pieces of at most `step` [m] that cover `length` [m], in [1, kMaxPieces]. The
+// division is clamped as a double: the length may be of any size.
+std::size_t piece_count(double length, double step) {
+  const double n = std::ceil(length / step);
+  if (!(n >= 1.0)) return 1;  // also NaN
+  return static_cast<std::size_t>(std::min(n, kMaxPieces));
+}
 
 std::vector<Vec2> to_vecs(const std::vector<Point2>& pts) {
   std::vector<Vec2> out;
@@ -52,7 +65,7 @@ std::vector<Polygon> cut_into_pieces(const Polyline& left, const Polyline& right
 // Midline of two bounds, matched by normalised arc length.
 Polyline derive_centerline(const Polyline& left, const Polyline& right) {
   const double len = std::max(left.length(), right.length());
-  const auto n = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(len / kCenterlineStep)) + 1);
+  const std::size_t n = piece_count(len, kCenterlineStep) + 1;
   std::vector<Vec2> pts;
   pts.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -115,19 +128,31 @@ void LaneWorld::build_topology() {
 
 template <typename F>
 void LaneWorld::for_cells(const Aabb& box, F&& f) const {
-  const long x0 = static_cast<long>(std::floor(box.min.x() / cell_size_));
-  const long x1 = static_cast<long>(std::floor(box.max.x() / cell_size_));
-  const long y0 = static_cast<long>(std::floor(box.min.y() / cell_size_));
-  const long y1 = static_cast<long>(std::floor(box.max.y() / cell_size_));
-  for (long ix = x0; ix <= x1; ++ix) {
-    for (long iy = y0; iy <= y1; ++iy) f(cell_key(ix, iy));
+  const std::int64_t x0 = cell_index(box.min.x(), cell_size_);
+  const std::int64_t x1 = cell_index(box.max.x(), cell_size_);
+  const std::int64_t y0 = cell_index(box.min.y(), cell_size_);
+  const std::int64_t y1 = cell_index(box.max.y(), cell_size_);
+  for (std::int64_t ix = x0; ix <= x1; ++ix) {
+    for (std::int64_t iy = y0; iy <= y1; ++iy) f(cell_key(ix, iy));
   }
+}
+
+double LaneWorld::cell_count(const Aabb& box) const {
+  // In double: the clamped indices span up to 2^31 cells each way.
+  const auto span = [this](double lo, double hi) {
+    return static_cast<double>(cell_index(hi, cell_size_) - cell_index(lo, cell_size_) + 1);
+  };
+  return span(box.min.x(), box.max.x()) * span(box.min.y(), box.max.y());
 }
 
 void LaneWorld::build_index() {
   for (std::size_t i = 0; i < lanes_.size(); ++i) {
     for (std::size_t k = 0; k < lanes_[i].pieces.size(); ++k) {
-      for_cells(lanes_[i].piece_boxes[k], [&](std::int64_t key) {
+      if (cell_count(lanes_[i].piece_boxes[k]) > kMaxIndexedCells) {
+        wide_pieces_.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k));
+        continue;
+      }
+      for_cells(lanes_[i].piece_boxes[k], [&](std::uint64_t key) {
         lane_cells_[key].emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k));
       });
     }
@@ -147,7 +172,7 @@ void LaneWorld::build_index() {
       const Vec2 dir = (b - a) / len;
       // For a counter-clockwise polygon the outside is on the right of each edge.
       const Vec2 outward = -orientation * left_normal(dir);
-      const auto pieces = static_cast<std::size_t>(std::ceil(len / kEdgePieceLength));
+      const std::size_t pieces = piece_count(len, kEdgePieceLength);
       // Consecutive outer pieces of one edge are merged back into one segment, so that the
       // departure test sees few long segments.
       std::optional<Vec2> run_start;
@@ -169,18 +194,28 @@ void LaneWorld::build_index() {
     Aabb box;
     box.extend(outer_edges_[e].first);
     box.extend(outer_edges_[e].second);
-    for_cells(box, [&](std::int64_t key) { edge_cells_[key].push_back(static_cast<std::uint32_t>(e)); });
+    if (cell_count(box) > kMaxIndexedCells) {
+      wide_edges_.push_back(static_cast<std::uint32_t>(e));
+      continue;
+    }
+    for_cells(box, [&](std::uint64_t key) { edge_cells_[key].push_back(static_cast<std::uint32_t>(e)); });
   }
 }
 
 template <typename F>
 bool LaneWorld::any_piece_containing(const Vec2& p, F&& accept) const {
-  const auto it = lane_cells_.find(
-      cell_key(static_cast<long>(std::floor(p.x() / cell_size_)), static_cast<long>(std::floor(p.y() / cell_size_))));
-  if (it == lane_cells_.end()) return false;
-  for (const auto& [lane, piece] : it->second) {
+  const auto test = [&](std::uint32_t lane, std::uint32_t piece) {
     const LaneGeometry& g = lanes_[lane];
-    if (g.piece_boxes[piece].contains(p) && point_in_polygon(g.pieces[piece], p) && accept(lane)) return true;
+    return g.piece_boxes[piece].contains(p) && point_in_polygon(g.pieces[piece], p) && accept(lane);
+  };
+  const auto it = lane_cells_.find(cell_key(cell_index(p.x(), cell_size_), cell_index(p.y(), cell_size_)));
+  if (it != lane_cells_.end()) {
+    for (const auto& [lane, piece] : it->second) {
+      if (test(lane, piece)) return true;
+    }
+  }
+  for (const auto& [lane, piece] : wide_pieces_) {
+    if (test(lane, piece)) return true;
   }
   return false;
 }
@@ -255,20 +290,27 @@ bool LaneWorld::footprint_inside(const std::array<Vec2, 4>& corners) const {
   }
   Aabb box;
   for (const Vec2& c : corners) box.extend(c);
+  const auto crosses_edge = [&](std::uint32_t e) {
+    const auto& [a, b] = outer_edges_[e];
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (segments_intersect(corners[k], corners[(k + 1) % 4], a, b)) return true;
+    }
+    return false;
+  };
   bool crosses = false;
-  for_cells(box, [&](std::int64_t key) {
+  for_cells(box, [&](std::uint64_t key) {
     if (crosses) return;
     const auto it = edge_cells_.find(key);
     if (it == edge_cells_.end()) return;
     // An edge spanning several cells is tested once per cell: cheaper than remembering it.
     for (std::uint32_t e : it->second) {
-      const auto& [a, b] = outer_edges_[e];
-      for (std::size_t k = 0; k < 4 && !crosses; ++k) {
-        crosses = segments_intersect(corners[k], corners[(k + 1) % 4], a, b);
+      if (crosses_edge(e)) {
+        crosses = true;
+        return;
       }
-      if (crosses) return;
     }
   });
+  for (std::size_t i = 0; i < wide_edges_.size() && !crosses; ++i) crosses = crosses_edge(wide_edges_[i]);
   return !crosses;
 }
 

@@ -6,6 +6,8 @@
 #include <map>
 #include <utility>
 
+#include "pullout/geometry/grid_cell.hpp"
+
 namespace pullout {
 
 namespace {
@@ -101,8 +103,6 @@ double box_distance(const Box2& b, const Point2& p) {
   return std::hypot(dx, dy);
 }
 
-std::int64_t cell_key(long ix, long iy) { return (static_cast<std::int64_t>(ix) << 32) ^ (iy & 0xffffffff); }
-
 }  // namespace
 
 LaneletMap::LaneletMap(std::vector<Lanelet> lanelets, LaneletMapInfo info)
@@ -169,18 +169,18 @@ void LaneletMap::build_topology() {
 
 template <typename F>
 void LaneletMap::for_cells(const Box2& box, F&& f) const {
-  const long x0 = static_cast<long>(std::floor(box.min_x / cell_size_));
-  const long x1 = static_cast<long>(std::floor(box.max_x / cell_size_));
-  const long y0 = static_cast<long>(std::floor(box.min_y / cell_size_));
-  const long y1 = static_cast<long>(std::floor(box.max_y / cell_size_));
-  for (long ix = x0; ix <= x1; ++ix) {
-    for (long iy = y0; iy <= y1; ++iy) f(cell_key(ix, iy));
+  const std::int64_t x0 = cell_index(box.min_x, cell_size_);
+  const std::int64_t x1 = cell_index(box.max_x, cell_size_);
+  const std::int64_t y0 = cell_index(box.min_y, cell_size_);
+  const std::int64_t y1 = cell_index(box.max_y, cell_size_);
+  for (std::int64_t ix = x0; ix <= x1; ++ix) {
+    for (std::int64_t iy = y0; iy <= y1; ++iy) f(cell_key(ix, iy));
   }
 }
 
 void LaneletMap::build_index() {
   for (std::size_t i = 0; i < lanelets_.size(); ++i) {
-    for_cells(lanelets_[i].box, [&](std::int64_t key) { cells_[key].push_back(static_cast<std::uint32_t>(i)); });
+    for_cells(lanelets_[i].box, [&](std::uint64_t key) { cells_[key].push_back(static_cast<std::uint32_t>(i)); });
   }
 }
 
@@ -198,8 +198,7 @@ std::size_t LaneletMap::count(LaneletSubtype subtype) const {
 std::vector<std::size_t> LaneletMap::lanelets_containing(const Point2& p) const {
   std::vector<std::size_t> out;
   if (!std::isfinite(p.x) || !std::isfinite(p.y)) return out;
-  const auto it = cells_.find(
-      cell_key(static_cast<long>(std::floor(p.x / cell_size_)), static_cast<long>(std::floor(p.y / cell_size_))));
+  const auto it = cells_.find(cell_key(cell_index(p.x, cell_size_), cell_index(p.y, cell_size_)));
   if (it == cells_.end()) return out;
   for (std::uint32_t i : it->second) {
     const Lanelet& ll = lanelets_[i];
@@ -230,7 +229,7 @@ std::vector<std::size_t> LaneletMap::lanelets_near(const Point2& p, double radiu
       if (box_distance(lanelets_[i].box, p) <= radius) candidates.push_back(i);
     }
   } else {
-    for_cells(query, [&](std::int64_t key) {
+    for_cells(query, [&](std::uint64_t key) {
       const auto it = cells_.find(key);
       if (it == cells_.end()) return;
       for (std::uint32_t i : it->second) {

@@ -37,7 +37,8 @@ class Costmap {
   // An axis-aligned grid over `extent` (map frame) at `resolution`: free where a cell lies inside
   // the union of `drivable` polygons (simple polygons, any orientation) and touches no `obstacles`
   // polygon. `drivable_outline` lists the edges of the union's outline (edges shared by two lanes
-  // excluded); cells it touches are obstacles.
+  // excluded); cells it touches are obstacles. At most 16384 cells a side: a larger extent is cut
+  // at its max corner (what is cut off lies outside the grid, so counts as occupied).
   static Costmap from_polygons(const Aabb& extent, double resolution, const std::vector<Polygon>& drivable,
                                const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
                                const std::vector<Polygon>& obstacles);

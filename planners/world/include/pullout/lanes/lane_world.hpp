@@ -3,7 +3,8 @@
 //
 // Topology: lane B succeeds lane A when B's bounds start where A's bounds end (both end points
 // within 0.1 m). Lanes are expected to be valid (see StartPlanner::validate): at least two points
-// per bound and a polygon with non-zero area.
+// per bound and a polygon with non-zero area. Derived centerlines are sampled every 0.5 m, and
+// edges cut into 0.5 m pieces, up to 1e5 per line (longer lines get longer steps).
 #pragma once
 
 #include <array>
@@ -78,19 +79,25 @@ class LaneWorld {
   void build_topology();
   void build_index();
   bool inside_other_lane(const Vec2& p, std::size_t lane) const;
-  std::int64_t cell_key(long ix, long iy) const { return (static_cast<std::int64_t>(ix) << 32) ^ (iy & 0xffffffff); }
   template <typename F>
   void for_cells(const Aabb& box, F&& f) const;
 
   std::vector<LaneGeometry> lanes_;
   // Pieces of lane edges that are not shared with a neighbouring lane: the outline of the union.
   std::vector<std::pair<Vec2, Vec2>> outer_edges_;
-  double cell_size_{4.0};
-  // Cell -> (lane index, piece index) of the lane pieces overlapping the cell.
-  std::unordered_map<std::int64_t, std::vector<std::pair<std::uint32_t, std::uint32_t>>> lane_cells_;
+  double cell_size_{4.0};  // [m] cells of the index: pullout/geometry/grid_cell.hpp
+  // Cell -> (lane index, piece index) of the lane pieces overlapping the cell. A piece or edge
+  // whose box covers more than kMaxIndexedCells cells (a long diagonal, far-apart points) is kept
+  // in a list tested on every query instead, so that the index costs what the lanes hold, not
+  // what their coordinates span.
+  static constexpr double kMaxIndexedCells = 4096;
+  std::unordered_map<std::uint64_t, std::vector<std::pair<std::uint32_t, std::uint32_t>>> lane_cells_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> wide_pieces_;
   template <typename F>
   bool any_piece_containing(const Vec2& p, F&& accept) const;
-  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> edge_cells_;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edge_cells_;
+  std::vector<std::uint32_t> wide_edges_;
+  double cell_count(const Aabb& box) const;
 };
 
 }  // namespace pullout

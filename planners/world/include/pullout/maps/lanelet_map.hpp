@@ -109,8 +109,8 @@ class LaneletMap {
   LaneletMapInfo info_;
   std::unordered_map<std::int64_t, std::size_t> by_id_;
   // Uniform grid over the lanelets' bounding boxes: cell key -> lanelet indices.
-  double cell_size_{16.0};  // [m]
-  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells_;
+  double cell_size_{16.0};  // [m] cells: pullout/geometry/grid_cell.hpp
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
 };
 
 // The lanelet as an inline lane for the planning core (road and road_shoulder only; nullopt for
