@@ -499,6 +499,7 @@ msg::PullOutStatus to_msg(const PullOutStatus& in) {
   out.departed(in.departed);
   out.turn_signal(enum_to_msg<TurnSignal, msg::TurnSignal>(in.turn_signal));
   out.turn_signal_start(to_msg_time(in.turn_signal_start_ns));
+  out.path_end(in.path_end);
   return out;
 }
 
@@ -543,6 +544,7 @@ PullOutStatus from_msg(const msg::PullOutStatus& in, std::vector<RequestIssue>& 
   out.departed = in.departed();
   out.turn_signal = lenient_enum(in.turn_signal(), msg::TURN_SIGNAL_RIGHT, TurnSignal::kNone);
   out.turn_signal_start_ns = from_msg_time(in.turn_signal_start());
+  out.path_end = in.path_end();
   return out;
 }
 

@@ -214,11 +214,12 @@ TEST(FreespacePullOut, CancelledFlagStopsThePullOutSearch) {
       nullptr, &polygons};
   std::atomic<bool> cancel{false};
   const StopCondition stop = StopCondition().with_cancel(&cancel);
-  const PlannerCandidates running = FreespacePullOut().plan(ctx, sc.request.ego_pose, stop);
+  const PlannerCandidates running =
+      FreespacePullOut(sc.parameters.freespace_planner).plan(ctx, sc.request.ego_pose, stop);
   ASSERT_EQ(running.candidates.size(), 1u);  // it finds one when not cancelled
   EXPECT_EQ(running.stopped, StopReason::kNone);
   cancel = true;
-  const PlannerCandidates r = FreespacePullOut().plan(ctx, sc.request.ego_pose, stop);
+  const PlannerCandidates r = FreespacePullOut(sc.parameters.freespace_planner).plan(ctx, sc.request.ego_pose, stop);
   EXPECT_TRUE(r.candidates.empty());
   EXPECT_EQ(r.stopped, StopReason::kCancelled);
   EXPECT_EQ(select_candidate(r, 0.1).outcome, AttemptOutcome::kCancelled);

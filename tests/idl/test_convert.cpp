@@ -384,7 +384,9 @@ TEST(Convert, StatusRoundTrip) {
   in.departed = true;
   in.turn_signal = TurnSignal::kRight;
   in.turn_signal_start_ns = 1'700'000'000'123'456'789;
+  in.path_end = "stops 2.01 m before object 7, 20.9 m beyond the end pose";
   const PullOutStatus waiting = from_msg(to_msg(in));
+  EXPECT_EQ(waiting.path_end, in.path_end);
   EXPECT_EQ(waiting.state, ExecutionState::kWaitingSafety);
   EXPECT_EQ(waiting.stop_reason, in.stop_reason);
   EXPECT_FALSE(waiting.safe);

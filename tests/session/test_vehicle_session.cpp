@@ -9,8 +9,8 @@
 #include <string>
 
 #include "pullout/config/scenario.hpp"
-#include "pullout/search/stop_condition.hpp"
 #include "pullout/pipeline/start_planner.hpp"
+#include "pullout/search/stop_condition.hpp"
 #include "pullout/session/vehicle_session.hpp"
 #include "test_world.hpp"
 
@@ -119,6 +119,15 @@ TEST_F(Session, AFoundPathWaitsForApprovalWithTheVerdictAtTheStart) {
   EXPECT_TRUE(e.status->safe);
   EXPECT_FALSE(e.status->departed);
   EXPECT_EQ(e.status->segment_count, e.path->partial_paths.size());
+}
+
+TEST_F(Session, TheStatusSaysWhereAPathStopsBeforeAnObjectBeyondTheEndPose) {
+  const Scenario sc = scenario("car_parked_beyond_end");
+  use(sc);
+  const SessionEffects e = plan(sc.request);
+  ASSERT_TRUE(e.path && e.path->found && e.status);
+  EXPECT_NE(e.status->path_end.find("before object 7"), std::string::npos) << e.status->path_end;
+  EXPECT_EQ(e.path->partial_paths.back().points.back().longitudinal_velocity_mps, 0.0);
 }
 
 TEST_F(Session, AResultOfASupersededSearchIsDropped) {

@@ -152,7 +152,8 @@ PublishedPathEnd finish_published_path(PullOutPath& path, const ObjectChecker& o
   }
   if (seg.points.size() < 2) seg.points.push_back(seg.points.back());
   parts.resize(cut_k + 1);
-  if (path.pairs_terminal_velocity_and_accel.size() > cut_k + 1) path.pairs_terminal_velocity_and_accel.resize(cut_k + 1);
+  if (path.pairs_terminal_velocity_and_accel.size() > cut_k + 1)
+    path.pairs_terminal_velocity_and_accel.resize(cut_k + 1);
 
   // The ramp down to 0 at the stop.
   std::vector<double> room(seg.points.size(), 0.0);
@@ -181,13 +182,12 @@ PublishedPathEnd finish_published_path(PullOutPath& path, const ObjectChecker& o
       if (cut_k < pairs.size() && std::abs(pairs[cut_k].velocity_mps) > end_speed) {
         pairs[cut_k].velocity_mps = std::copysign(end_speed, pairs[cut_k].velocity_mps);
       }
-      note += "; too close to stop from " + fixed(planned_end_speed, 1) + " m/s within " +
-              fixed(limits.max_deceleration_mps2, 1) + " m/s^2 and " + fixed(limits.max_jerk_mps3, 1) +
-              " m/s^3 (needs " +
-              fixed(jerk_limited_stop_distance(planned_end_speed, limits.max_deceleration_mps2, limits.max_jerk_mps3),
-                    1) +
-              " m): the speed at the end pose is lowered to " + fixed(end_speed, 1) +
-              " m/s and comes down to 0 at the stop";
+      note +=
+          "; too close to stop from " + fixed(planned_end_speed, 1) + " m/s within " +
+          fixed(limits.max_deceleration_mps2, 1) + " m/s^2 and " + fixed(limits.max_jerk_mps3, 1) + " m/s^3 (needs " +
+          fixed(jerk_limited_stop_distance(planned_end_speed, limits.max_deceleration_mps2, limits.max_jerk_mps3), 1) +
+          " m): the speed at the end pose is lowered to " + fixed(end_speed, 1) +
+          " m/s and comes down to 0 at the stop";
     }
   }
   out.note = std::move(note);

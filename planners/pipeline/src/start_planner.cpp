@@ -399,8 +399,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   const bool freespace_listed = std::find(params.search_priority.begin(), params.search_priority.end(),
                                           PlannerType::kFreespace) != params.search_priority.end();
   if (params.freespace_planner.enable_freespace_planner && !freespace_listed && result.stopped == StopReason::kNone) {
-    const PlannerCandidates fallback =
-        FreespacePullOut(params.freespace_planner).plan(context, request.ego_pose, stop);
+    const PlannerCandidates fallback = FreespacePullOut(params.freespace_planner).plan(context, request.ego_pose, stop);
     if (fallback.stopped == StopReason::kDeadline || fallback.stopped == StopReason::kCancelled) {
       result.stopped = fallback.stopped;
     }

@@ -157,6 +157,7 @@ SessionEffects VehicleSession::on_result(std::uint64_t sequence, const PlanningR
       status.state = ExecutionState::kWaitingApproval;
       status.stop_reason = "waiting approval";
       status.turn_signal = path.turn_signal;
+      status.path_end = result.path_end.note;
       break;
     case PlanningResult::Outcome::kNoPath:
       path = result.path;

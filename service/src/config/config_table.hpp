@@ -18,6 +18,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -141,6 +142,25 @@ using Hint = const char* (*)(const std::string& key);
 
 template <typename S>
 struct Entry {
+  Entry() = default;
+  // An entry of a base struct B serves in the table of S: `field("k", &S::k, ...)` deduces B when
+  // S inherits k from B (StartPlannerParameters aggregates each module's parameters that way).
+  template <typename B, typename = std::enable_if_t<std::is_base_of_v<B, S> && !std::is_same_v<B, S>>>
+  Entry(Entry<B> base)  // NOLINT(google-explicit-constructor): used in brace-initialised tables
+      : key(std::move(base.key)), documented(base.documented) {
+    if (base.read) read = [f = std::move(base.read)](MapReader& r, S& s) { f(r, static_cast<B&>(s)); };
+    if (base.check) {
+      check = [f = std::move(base.check)](const S& s, const std::string& prefix, Problems& out) {
+        f(static_cast<const B&>(s), prefix, out);
+      };
+    }
+    if (base.write) {
+      write = [f = std::move(base.write)](const S& s, int indent, Doc& out) {
+        f(static_cast<const B&>(s), indent, out);
+      };
+    }
+  }
+
   std::string key;  // empty for a note
   bool documented{true};
   std::function<void(MapReader&, S&)> read;

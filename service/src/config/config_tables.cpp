@@ -410,6 +410,8 @@ const Table<ServiceConfig>& service_table() {
       field("default_deadline_ms", &T::default_deadline_ms, "ms", above(0.0),
             "planning budget when a request gives none, <= limits.max_deadline_ms"),
       field("log_level", &T::log_level, "", Choices{{kLogLevels.begin(), kLogLevels.end()}}, ""),
+      field("progress_timeout_s", &T::progress_timeout_s, "s", in(0.0, 60.0),
+            "a departed vehicle silent this long is told to stop (odometry lost); 0 = never"),
       note<T>("Size limits of one request; a larger request is rejected with the field named."),
       group("limits", &T::limits, &limits_table, ""),
   }};

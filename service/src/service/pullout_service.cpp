@@ -48,7 +48,7 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
     : config_(config),
       dds_(config.dds),
       planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
-      registry_(planner_, dds_) {
+      registry_(planner_, dds_, SessionOptions{config.service.progress_timeout_s}) {
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
 }
 

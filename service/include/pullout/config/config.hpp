@@ -43,6 +43,8 @@ struct ServiceConfig {
   double default_deadline_ms{200.0};  // [ms]
   RequestLimits limits;
   std::string log_level{"info"};  // one of kLogLevels
+  // [s] A departed vehicle with no progress sample for this long is told to stop (0: never).
+  double progress_timeout_s{2.0};
 };
 
 struct MapConfig {

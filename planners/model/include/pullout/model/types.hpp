@@ -215,6 +215,9 @@ struct PullOutStatus {
   // which it is on; departure waits prepare_time_before_start after it. 0 = not on yet.
   TurnSignal turn_signal{TurnSignal::kNone};
   std::int64_t turn_signal_start_ns{0};
+  // A found path: how the published path ends, e.g. "stops 2.01 m before object 7, 20.9 m beyond
+  // the end pose" (the path's velocity is 0 there), or where it ends when nothing is in the way.
+  std::string path_end;
 };
 
 // A problem with a request: the field (e.g. "lanes[2].left_bound[5].x", "ego_pose.orientation")

@@ -44,9 +44,9 @@ class ObjectChecker;  // pullout/collision/object_checker.hpp (not included: thi
                       // the CLI through start_planner.hpp, without Eigen or FCL)
 
 struct PublishedPathLimits {
-  double margin_m{0.0};                // [m] clearance kept beyond the end pose (the attempt's margin)
-  double max_deceleration_mps2{1.0};   // [m/s^2] > 0, of the stop (stop_condition.*)
-  double max_jerk_mps3{1.0};           // [m/s^3] > 0
+  double margin_m{0.0};               // [m] clearance kept beyond the end pose (the attempt's margin)
+  double max_deceleration_mps2{1.0};  // [m/s^2] > 0, of the stop (stop_condition.*)
+  double max_jerk_mps3{1.0};          // [m/s^3] > 0
 };
 
 struct PublishedPathEnd {

@@ -54,8 +54,8 @@
 #include <string>
 #include <vector>
 
-#include "pullout/model/types.hpp"
 #include "pullout/execution/execution_tracker.hpp"
+#include "pullout/model/types.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "pullout/safety/safety_monitor.hpp"
 
