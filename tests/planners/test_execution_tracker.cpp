@@ -111,7 +111,7 @@ TEST(ExecutionTracker, ReverseLastSegmentCompletesBehindTheEndPose) {
 }
 
 TEST(ExecutionTracker, StandstillIsNotCreditedBeyondTheReceivingClock) {
-  ExecutionTracker t{StartPlannerParameters{}};
+  ExecutionTracker t{ExecutionParameters{}};
   t.start(two_segment_path());
   const auto received = std::chrono::steady_clock::time_point(std::chrono::seconds(100));
   // Stamps claim 3 s of standstill at the end of the reverse leg; 50 ms passed where it was received.

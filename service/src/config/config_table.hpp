@@ -18,6 +18,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -141,6 +142,16 @@ using Hint = const char* (*)(const std::string& key);
 
 template <typename S>
 struct Entry {
+  Entry() = default;
+  // An entry of a base struct B of S (a member S inherits, e.g. StartPlannerParameters'
+  // ExecutionParameters): &S::member names a member of B, so field() deduces Entry<B>.
+  template <typename B, typename = std::enable_if_t<std::is_base_of_v<B, S> && !std::is_same_v<B, S>>>
+  Entry(Entry<B> base) : key(std::move(base.key)), documented(base.documented) {  // NOLINT(google-explicit-constructor)
+    if (base.read) read = [f = std::move(base.read)](MapReader& r, S& s) { f(r, s); };
+    if (base.check) check = [f = std::move(base.check)](const S& s, const std::string& prefix, Problems& out) { f(s, prefix, out); };
+    if (base.write) write = [f = std::move(base.write)](const S& s, int indent, Doc& out) { f(s, indent, out); };
+  }
+
   std::string key;  // empty for a note
   bool documented{true};
   std::function<void(MapReader&, S&)> read;
