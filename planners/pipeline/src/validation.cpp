@@ -13,7 +13,6 @@ namespace pullout {
 
 namespace {
 
-constexpr std::size_t kMaxVehicleIdLength = 256;
 constexpr double kMinBoundLength = 0.1;  // [m]
 constexpr double kMinLaneArea = 1e-2;    // [m^2]
 
@@ -141,8 +140,8 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
   std::vector<RequestIssue> issues;
   Checker c(limits, issues);
   if (r.vehicle_id.empty()) c.add("vehicle_id", "empty");
-  if (r.vehicle_id.size() > kMaxVehicleIdLength) {
-    c.add("vehicle_id", "longer than " + std::to_string(kMaxVehicleIdLength) + " characters");
+  if (r.vehicle_id.size() > kMaxVehicleIdBytes) {
+    c.add("vehicle_id", "longer than " + std::to_string(kMaxVehicleIdBytes) + " bytes");
   }
   c.pose("ego_pose", r.ego_pose);
   c.finite("ego_velocity_mps", r.ego_velocity_mps);
