@@ -15,6 +15,7 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/config/scenario.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/published_path.hpp"
 #include "pullout/pipeline/start_planner.hpp"
@@ -78,8 +79,8 @@ TEST(SeparatingAxisOracle, KnowsOverlapFromGap) {
   const Convex a = box({0, 0, 0}, 1, 1, 1, 1);
   EXPECT_TRUE(overlap(a, box({1.9, 0, 0}, 1, 1, 1, 1)));
   EXPECT_FALSE(overlap(a, box({2.1, 0, 0}, 1, 1, 1, 1)));
-  EXPECT_FALSE(overlap(a, box({2.5, 2.5, M_PI / 4}, 1, 1, 1, 1)));  // corner to corner, apart
-  EXPECT_TRUE(overlap(a, box({2.3, 0, M_PI / 4}, 1, 1, 1, 1)));     // a corner of the diamond inside
+  EXPECT_FALSE(overlap(a, box({2.5, 2.5, kPi / 4}, 1, 1, 1, 1)));  // corner to corner, apart
+  EXPECT_TRUE(overlap(a, box({2.3, 0, kPi / 4}, 1, 1, 1, 1)));     // a corner of the diamond inside
 }
 
 const std::string kScenarioDir = std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios";
@@ -142,7 +143,8 @@ TEST(PublishedPath, EveryPointOfEveryFoundPathIsClearOfTheObjects) {
   for (const std::string& name : bundled_scenarios()) {
     const Scenario sc = load_scenario(kScenarioDir + "/" + name + ".yaml");
     std::vector<std::vector<PlannerType>> priorities{sc.parameters.search_priority};
-    for (PlannerType t : {PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid, PlannerType::kFreespace})
+    for (PlannerType t :
+         {PlannerType::kShift, PlannerType::kGeometric, PlannerType::kClothoid, PlannerType::kFreespace})
       priorities.push_back({t});
     for (const auto& priority : priorities) {
       StartPlannerParameters params = sc.parameters;
@@ -265,8 +267,9 @@ TEST(FinishPublishedPath, ACarBesideThePathBeforeTheEndPoseOnlyNeedsNoContact) {
   EXPECT_FALSE(end.stops_before_object);
   EXPECT_EQ(path.partial_paths[0].points.size(), 101u);
   EXPECT_NEAR(end.beyond_end_pose_m, 60.0, 1e-9);
-  EXPECT_EQ(end.note, "no object on the published path; it ends 60.0 m beyond the end pose at 5.0 m/s (end of the "
-                      "road lanes or forward_path_length)");
+  EXPECT_EQ(end.note,
+            "no object on the published path; it ends 60.0 m beyond the end pose at 5.0 m/s (end of the "
+            "road lanes or forward_path_length)");
 }
 
 TEST(FinishPublishedPath, DropsLaterSegmentsWhenAnEarlierOneIsBlocked) {
@@ -306,7 +309,8 @@ double simulated_stop(double v, double a_max, double j_max) {
 }
 
 TEST(JerkLimitedStopDistance, MatchesASimulatedStop) {
-  for (const auto& [v, a, j] : std::vector<std::array<double, 3>>{{13.89, 1.0, 1.0}, {0.5, 1.0, 1.0}, {5.0, 2.0, 0.5}}) {
+  for (const auto& [v, a, j] :
+       std::vector<std::array<double, 3>>{{13.89, 1.0, 1.0}, {0.5, 1.0, 1.0}, {5.0, 2.0, 0.5}}) {
     EXPECT_NEAR(jerk_limited_stop_distance(v, a, j), simulated_stop(v, a, j), 0.01 * simulated_stop(v, a, j) + 0.01)
         << v << " " << a << " " << j;
   }

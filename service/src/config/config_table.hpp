@@ -148,7 +148,8 @@ struct Entry {
   template <typename B, typename = std::enable_if_t<std::is_base_of_v<B, S> && !std::is_same_v<B, S>>>
   Entry(Entry<B> base) : key(std::move(base.key)), documented(base.documented) {  // NOLINT(google-explicit-constructor)
     if (base.read) read = [f = std::move(base.read)](MapReader& r, S& s) { f(r, s); };
-    if (base.check) check = [f = std::move(base.check)](const S& s, const std::string& prefix, Problems& out) { f(s, prefix, out); };
+    if (base.check)
+      check = [f = std::move(base.check)](const S& s, const std::string& prefix, Problems& out) { f(s, prefix, out); };
     if (base.write) write = [f = std::move(base.write)](const S& s, int indent, Doc& out) { f(s, indent, out); };
   }
 
