@@ -5,6 +5,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "pullout/geometry/polyline.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "validation.hpp"
@@ -58,12 +59,6 @@ class Checker {
   std::vector<RequestIssue>& issues_;
 };
 
-double line_length(const std::vector<Point2>& pts) {
-  double len = 0.0;
-  for (std::size_t i = 1; i < pts.size(); ++i) len += std::hypot(pts[i].x - pts[i - 1].x, pts[i].y - pts[i - 1].y);
-  return len;
-}
-
 double lane_area(const Lane& lane) {
   double twice = 0.0;
   std::vector<Point2> ring = lane.left_bound;
@@ -86,7 +81,7 @@ void validate_lane(Checker& c, const std::string& f, const Lane& lane) {
       ok = false;
     } else if (!c.points(lf, *line)) {
       ok = false;
-    } else if (line_length(*line) < kMinBoundLength) {
+    } else if (polyline_length(*line) < kMinBoundLength) {
       c.add(lf, "degenerate: shorter than " + std::to_string(kMinBoundLength) + " m");
       ok = false;
     }
