@@ -21,13 +21,14 @@
 #include "lot_shapes.hpp"
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace {
 
 using pullout::Pose2;
 
-constexpr double kPi = 3.14159265358979323846;
+using pullout::kPi;
 
 using pullout::bench::box;
 

@@ -45,6 +45,7 @@
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/freespace/hybrid_astar.hpp"
 #include "pullout/freespace/reeds_shepp.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace {
@@ -53,7 +54,7 @@ namespace ob = ompl::base;
 namespace og = ompl::geometric;
 using pullout::Pose2;
 
-constexpr double kPi = 3.14159265358979323846;
+using pullout::kPi;
 constexpr double kBayWidth = 2.7;  // [m]
 constexpr double kBayDepth = 5.5;  // [m]
 constexpr double kAisle = 7.0;     // [m]
@@ -131,7 +132,7 @@ Problem make_problem(int index, std::mt19937& rng, const pullout::Footprint& fp)
     const double inward = -b.faces;  // +y or -y into the bay
     const double yaw = inward > 0 ? kPi / 2 : -kPi / 2;
     if (nose_in) return Pose2{b.x, b.y_open + inward * (0.3 + fp.rear), yaw};
-    return Pose2{b.x, b.y_open + inward * (0.3 + fp.front), std::remainder(yaw + kPi, 2.0 * kPi)};
+    return Pose2{b.x, b.y_open + inward * (0.3 + fp.front), pullout::normalize_angle(yaw + kPi)};
   };
   std::shuffle(empty.begin(), empty.end(), rng);
   p.start = parked(bays[empty[0]], true);

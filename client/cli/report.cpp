@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pullout/geometry/polyline.hpp"
+
 namespace pullout::cli {
 
 namespace {
@@ -23,15 +25,6 @@ bool is_reverse(const PathWithLaneId& segment) {
     along += (b.x - a.x) * std::cos(a.yaw) + (b.y - a.y) * std::sin(a.yaw);
   }
   return along < 0.0;
-}
-
-double polyline_length(const PathWithLaneId& segment) {
-  double length = 0.0;
-  for (std::size_t i = 0; i + 1 < segment.points.size(); ++i) {
-    length += std::hypot(segment.points[i + 1].pose.x - segment.points[i].pose.x,
-                         segment.points[i + 1].pose.y - segment.points[i].pose.y);
-  }
-  return length;
 }
 
 void add_reason(std::vector<std::string>& reasons, const std::string& reason) {

@@ -5,13 +5,12 @@
 #include <sstream>
 #include <string>
 
+#include "pullout/geometry/angle.hpp"
 #include "pullout/model/names.hpp"
 
 namespace pullout::cli {
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 // printf-style formatting into a std::string (the C locale: '.' as decimal point).
 template <typename... Args>

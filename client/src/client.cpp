@@ -44,8 +44,6 @@ namespace dds = eprosima::fastdds::dds;
 using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
 using SteadyClock = std::chrono::steady_clock;
 
-// Content filter parameters travel in discovery as strings of at most 255 characters.
-constexpr std::size_t kMaxVehicleIdBytes = 255;
 constexpr int kMaxDomainId = 232;
 // Replies kept for wait_for_path / wait_for_status. Paths can be several hundred KB each.
 constexpr std::size_t kRecentPaths = 16;  // client.hpp promises the last 16

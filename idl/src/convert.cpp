@@ -22,9 +22,6 @@ namespace {
 // the request itself; the first few name the problem well enough.
 constexpr std::size_t kMaxIssues = 32;
 constexpr double kUnitQuaternionTolerance = 1e-3;
-// The key (vehicle_id) is serialized into a fixed 4 + 255 + 1 byte buffer by the generated type
-// support: a longer id cannot be written back as a reply key.
-constexpr std::size_t kMaxVehicleIdBytes = 255;
 
 // Appends issues up to kMaxIssues, then counts the rest and summarises them once in finish().
 class IssueSink {

@@ -7,13 +7,12 @@
 #include <gtest/gtest.h>
 
 #include "json_output.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "report.hpp"
 #include "text_output.hpp"
 
 namespace pullout::cli {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // A straight segment of n points from (x0, y) along +x (yaw 0) spaced 1 m, at velocity v.
 PathWithLaneId straight(double x0, double y, int n, double v, double step = 1.0) {

@@ -12,12 +12,11 @@
 #include <gtest/gtest.h>
 #include <tinyxml2.h>
 
+#include "pullout/geometry/angle.hpp"
 #include "svg_writer.hpp"
 
 namespace pullout::cli {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 PullOutRequest scene() {
   PullOutRequest request;

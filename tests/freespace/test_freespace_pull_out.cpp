@@ -15,6 +15,7 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/config/scenario.hpp"
+#include "pullout/geometry/polyline.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 
@@ -34,14 +35,6 @@ int direction_of(const PathWithLaneId& seg) {
     if (p.longitudinal_velocity_mps < 0.0) return -1;
   }
   return 0;
-}
-
-double polyline_length(const PathWithLaneId& seg) {
-  double len = 0.0;
-  for (std::size_t i = 1; i < seg.points.size(); ++i) {
-    len += std::hypot(seg.points[i].pose.x - seg.points[i - 1].pose.x, seg.points[i].pose.y - seg.points[i - 1].pose.y);
-  }
-  return len;
 }
 
 class FreespaceScenario : public ::testing::TestWithParam<const char*> {};

@@ -1,6 +1,7 @@
 // Hybrid A* on small costmaps built in code: properties of what it returns (collision-free,
 // curvature, direction bookkeeping), its typed failures, and the deadline.
 #include "pullout/freespace/hybrid_astar.hpp"
+#include "pullout/geometry/angle.hpp"
 
 #include <gtest/gtest.h>
 
@@ -65,7 +66,7 @@ TEST(HybridAStar, OpenLotReachesTheExactGoal) {
   const GridCollisionChecker checker(m, kCar);
   const HybridAStar planner(checker, config());
   const Pose2 start{6, 6, 0};
-  const Pose2 goal{22, 22, M_PI / 2};
+  const Pose2 goal{22, 22, kPi / 2};
   const HybridAStarResult r = planner.plan(start, goal, StopCondition::after_ms(2000));
   expect_drivable(checker, r, start, 5.2);
   EXPECT_TRUE(r.reached_exact_goal);
@@ -93,7 +94,7 @@ TEST(HybridAStar, TurningAroundInANarrowCorridorNeedsReversing) {
   const GridCollisionChecker checker(m, kCar);
   const HybridAStar planner(checker, config());
   const Pose2 start{20, 3.7, 0};
-  const Pose2 goal{20, 3.7, M_PI};
+  const Pose2 goal{20, 3.7, kPi};
   const HybridAStarResult r = planner.plan(start, goal, StopCondition::after_ms(3000));
   expect_drivable(checker, r, start, 5.2);
   int changes = 0;
@@ -112,7 +113,7 @@ TEST(HybridAStar, EveryPointOfThePathIsFreeNotOnlyTheTestedPoses) {
   c.waypoint_interval = 0.01;
   const HybridAStar planner(checker, c);
   const Pose2 start{4, 10, 0};
-  const Pose2 goal{9.65, 1.5, M_PI / 2};  // rear axle in the bay, nose to the aisle
+  const Pose2 goal{9.65, 1.5, kPi / 2};  // rear axle in the bay, nose to the aisle
   const HybridAStarResult r = planner.plan(start, goal, StopCondition::after_ms(5000));
   ASSERT_EQ(r.status, HybridAStarResult::Status::kSuccess);
   ASSERT_GT(r.waypoints.size(), 500u);

@@ -1,6 +1,7 @@
 // Reeds-Shepp curves. Oracle: driving every returned word segment by segment (independent
 // integration of the arcs, 2 mm steps) must end at the goal; lengths obey the metric's properties.
 #include "pullout/freespace/reeds_shepp.hpp"
+#include "pullout/geometry/angle.hpp"
 
 #include <gtest/gtest.h>
 
@@ -31,7 +32,7 @@ Pose2 integrate(const Pose2& from, const ReedsSheppPath& p, double radius) {
   return q;
 }
 
-double angle_diff(double a, double b) { return std::remainder(a - b, 2.0 * M_PI); }
+double angle_diff(double a, double b) { return std::remainder(a - b, 2.0 * kPi); }
 
 std::string word(const ReedsSheppPath& p) {
   std::string w;
@@ -47,7 +48,7 @@ TEST(ReedsShepp, EveryWordReachesTheGoal) {
   const double radius = 4.0;
   const ReedsShepp rs(radius);
   std::mt19937 rng(3);
-  std::uniform_real_distribution<double> pos(-15.0, 15.0), yaw(-M_PI, M_PI);
+  std::uniform_real_distribution<double> pos(-15.0, 15.0), yaw(-kPi, kPi);
   std::set<int> counts;
   std::set<std::string> shortest_words;
   for (int n = 0; n < 200; ++n) {
@@ -94,9 +95,9 @@ TEST(ReedsShepp, QuarterTurnIsOneArc) {
   const double r = 5.0;
   const ReedsShepp rs(r);
   // A left quarter circle: from (0, 0, 0) to (r, r, pi/2).
-  EXPECT_NEAR(rs.distance({0, 0, 0}, {r, r, M_PI / 2}), r * M_PI / 2, 1e-9);
+  EXPECT_NEAR(rs.distance({0, 0, 0}, {r, r, kPi / 2}), r * kPi / 2, 1e-9);
   // Turning on the spot by pi needs cusps and is longer than the half circle around.
-  const ReedsSheppPath turn = rs.shortest({0, 0, 0}, {0, 0, M_PI});
+  const ReedsSheppPath turn = rs.shortest({0, 0, 0}, {0, 0, kPi});
   EXPECT_GT(turn.cusps(), 0);
   EXPECT_GT(turn.length, 0.0);
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pullout/collision/footprint.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/geometry/polygon.hpp"
 #include "pullout/model/types.hpp"
 
@@ -158,7 +159,7 @@ inline std::vector<Pose2> poses_along(const PathWithLaneId& seg, double step) {
     const Pose2& a = seg.points[i].pose;
     const Pose2& b = seg.points[i + 1].pose;
     const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / step)));
-    const double dyaw = std::remainder(b.yaw - a.yaw, 2.0 * M_PI);
+    const double dyaw = std::remainder(b.yaw - a.yaw, 2.0 * kPi);
     for (int k = 0; k < n; ++k) {
       const double t = static_cast<double>(k) / n;
       out.push_back({a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.yaw + t * dyaw});

@@ -233,7 +233,6 @@ TEST_P(SharedMaps, LoadWithTheirLaneletAndShoulderCounts) {
   const auto map = load_lanelet_map(path);
   EXPECT_EQ(map->lanelets().size(), GetParam().lanelets);
   EXPECT_EQ(map->count(LaneletSubtype::kRoadShoulder), GetParam().shoulders);
-  EXPECT_FALSE(map->info().projected);  // Autoware's maps carry local_x/local_y
 }
 
 // From the middle of every road_shoulder lanelet, on its centerline, onto the road beside it.

@@ -1,4 +1,5 @@
 #include "pullout/collision/object_checker.hpp"
+#include "pullout/geometry/angle.hpp"
 
 #include <gtest/gtest.h>
 
@@ -30,7 +31,7 @@ TEST(ObjectChecker, DistanceToTheSideAndRotatedPose) {
   // Left side of the vehicle at y = 1, bottom of the box at y = 4.
   EXPECT_NEAR(checker.clearance({0.0, 0.0, 0.0}).distance, 3.0, kGjkTolerance);
   // Turned by 90 degrees the front (3 m ahead of base_link) points at the box: gap 4 - 3 = 1.
-  EXPECT_NEAR(checker.clearance({0.0, 0.0, M_PI / 2}).distance, 1.0, kGjkTolerance);
+  EXPECT_NEAR(checker.clearance({0.0, 0.0, kPi / 2}).distance, 1.0, kGjkTolerance);
 }
 
 TEST(ObjectChecker, CornerToCornerDistanceIsEuclidean) {
@@ -78,7 +79,7 @@ TEST(Footprint, VehicleRectangleFromVehicleInfo) {
   EXPECT_DOUBLE_EQ(f.front, 2.79 + 1.0 + 0.5);
   EXPECT_DOUBLE_EQ(f.rear, 1.1 + 0.5);
   EXPECT_DOUBLE_EQ(f.left, 0.82 + 0.128 + 0.5);
-  const auto c = footprint_corners(f, {1.0, 2.0, M_PI / 2});
+  const auto c = footprint_corners(f, {1.0, 2.0, kPi / 2});
   // Front-left corner of a vehicle facing +y: x decreases by `left`, y increases by `front`.
   EXPECT_NEAR(c[0].x(), 1.0 - f.left, 1e-12);
   EXPECT_NEAR(c[0].y(), 2.0 + f.front, 1e-12);

@@ -15,6 +15,7 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/config/scenario.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/published_path.hpp"
 #include "pullout/pipeline/start_planner.hpp"
@@ -78,8 +79,8 @@ TEST(SeparatingAxisOracle, KnowsOverlapFromGap) {
   const Convex a = box({0, 0, 0}, 1, 1, 1, 1);
   EXPECT_TRUE(overlap(a, box({1.9, 0, 0}, 1, 1, 1, 1)));
   EXPECT_FALSE(overlap(a, box({2.1, 0, 0}, 1, 1, 1, 1)));
-  EXPECT_FALSE(overlap(a, box({2.5, 2.5, M_PI / 4}, 1, 1, 1, 1)));  // corner to corner, apart
-  EXPECT_TRUE(overlap(a, box({2.3, 0, M_PI / 4}, 1, 1, 1, 1)));     // a corner of the diamond inside
+  EXPECT_FALSE(overlap(a, box({2.5, 2.5, kPi / 4}, 1, 1, 1, 1)));  // corner to corner, apart
+  EXPECT_TRUE(overlap(a, box({2.3, 0, kPi / 4}, 1, 1, 1, 1)));     // a corner of the diamond inside
 }
 
 const std::string kScenarioDir = std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios";

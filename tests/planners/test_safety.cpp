@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "pullout/config/scenario.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "pullout/safety/rss_check.hpp"
 #include "pullout/safety/safety_monitor.hpp"
@@ -107,7 +108,7 @@ TEST_F(RssCheck, LateralThreshold) {
 
 TEST_F(RssCheck, OncomingObjectsAreSkipped) {
   // Heading differs by pi > 1.578 rad: not checked (oncoming traffic is another lane's business).
-  EXPECT_TRUE(check(car(3, 40.0, 3.0, 10.0, M_PI)).safe);
+  EXPECT_TRUE(check(car(3, 40.0, 3.0, 10.0, kPi)).safe);
 }
 
 TEST_F(RssCheck, PredictedPathIsFollowed) {

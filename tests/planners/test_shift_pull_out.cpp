@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "path_oracles.hpp"
+#include "pullout/geometry/polyline.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "test_world.hpp"
 
@@ -218,11 +219,9 @@ TEST(ShiftPullOut, StraightShoulderPathIsContinuousAndEndsOnTheCenterline) {
   EXPECT_NEAR(path.pairs_terminal_velocity_and_accel[0].velocity_mps, T, 1e-9);
   EXPECT_DOUBLE_EQ(path.pairs_terminal_velocity_and_accel[0].accel_mps2, 1.0);
   // The shift section is as long as the kinematics say (within one sample of arc length).
-  double len = 0.0;
-  for (std::size_t i = 1; i <= end_idx; ++i) {
-    len += std::hypot(seg.points[i].pose.x - seg.points[i - 1].pose.x, seg.points[i].pose.y - seg.points[i - 1].pose.y);
-  }
-  EXPECT_NEAR(len, shift_distance, 0.05);
+  PathWithLaneId shift_section = seg;
+  shift_section.points.resize(end_idx + 1);
+  EXPECT_NEAR(polyline_length(shift_section), shift_distance, 0.05);
 }
 
 TEST(ShiftPullOut, CurvedRoadStaysWithinTheSteeringLimitAndEndsOnTheCenterline) {

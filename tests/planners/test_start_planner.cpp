@@ -256,6 +256,20 @@ TEST(StartPlannerValidation, SizeLimits) {
   EXPECT_NE(text.find("lanes[0].left_bound: 11 points exceed the limit of 10"), std::string::npos) << text;
 }
 
+// The generated DDS key buffer holds kMaxVehicleIdBytes bytes: a longer id could not be answered.
+TEST(StartPlannerValidation, VehicleIdLongerThanTheKeyBufferIsRejected) {
+  auto req = test::straight_shoulder_request();
+  req.vehicle_id = std::string(kMaxVehicleIdBytes, 'v');
+  auto issues = default_planner().validate(req);
+  EXPECT_TRUE(issues.empty()) << format_issues(issues);
+
+  req.vehicle_id = std::string(256, 'v');
+  issues = default_planner().validate(req);
+  ASSERT_EQ(issues.size(), 1u) << format_issues(issues);
+  EXPECT_EQ(issues[0].field, "vehicle_id");
+  EXPECT_NE(issues[0].problem.find("longer than 255 bytes"), std::string::npos) << format_issues(issues);
+}
+
 TEST(StartPlannerValidation, RouteWithoutMapAndBadDeadline) {
   auto req = test::straight_shoulder_request();
   req.route_lanelet_ids = {4618};

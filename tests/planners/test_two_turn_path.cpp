@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "pullout/config/scenario.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/geometry/curvature_path.hpp"
 #include "pullout/model/types.hpp"
 #include "pullout/pipeline/start_planner.hpp"
@@ -31,10 +32,10 @@ double max_sampled_curvature(const std::vector<Pose2>& poses) {
 
 TEST(CurvaturePath, ArcEndsWhereGeometrySays) {
   // A quarter circle of radius 5 to the left from the origin ends at (5, 5) facing +y.
-  const CurvaturePath arc({0.0, 0.0, 0.0}, {{5.0 * M_PI / 2.0, 0.2, 0.2}});
+  const CurvaturePath arc({0.0, 0.0, 0.0}, {{5.0 * kPi / 2.0, 0.2, 0.2}});
   EXPECT_NEAR(arc.end().x, 5.0, 1e-12);
   EXPECT_NEAR(arc.end().y, 5.0, 1e-12);
-  EXPECT_NEAR(arc.end().yaw, M_PI / 2.0, 1e-12);
+  EXPECT_NEAR(arc.end().yaw, kPi / 2.0, 1e-12);
 }
 
 TEST(CurvaturePath, ClothoidIntegrationMatchesAFineEulerReference) {
@@ -74,9 +75,9 @@ TEST(TwoTurnPath, ArcSCurveMatchesTheWorkedExample) {
 TEST(TwoTurnPath, ClothoidTurnsStayWithinTheirPeakCurvature) {
   const VehicleInfo v;
   for (double steer_deg : {5.0, 10.0, 20.0, 30.0}) {
-    const double steer = steer_deg * M_PI / 180.0;
+    const double steer = steer_deg * kDegToRad;
     const double kappa = std::tan(steer) / v.wheel_base_m;
-    const double clothoid_length = 1.0 * steer / (10.0 * M_PI / 180.0);
+    const double clothoid_length = 1.0 * steer / (10.0 * kDegToRad);
     for (double offset : {0.3, 1.0, 3.25, 6.0}) {
       const auto t = solve_two_turn({0.0, offset, 0.0}, straight_centerline(), {kappa, kappa / clothoid_length, 0.0});
       ASSERT_TRUE(t.has_value()) << steer_deg << " deg, offset " << offset;
@@ -96,7 +97,7 @@ TEST(TwoTurnPath, ClothoidTurnsStayWithinTheirPeakCurvature) {
 
 TEST(TwoTurnPath, PerpendicularStartTurnsOntoTheLane) {
   // Facing -y, 6 m left of the centerline: turns left by 90 degrees in total.
-  const auto t = solve_two_turn({0.0, 6.0, -M_PI / 2.0}, straight_centerline(), {0.2, 0.0, 1.0});
+  const auto t = solve_two_turn({0.0, 6.0, -kPi / 2.0}, straight_centerline(), {0.2, 0.0, 1.0});
   ASSERT_TRUE(t.has_value());
   EXPECT_NEAR(t->path.end().y, 0.0, 1e-3);
   EXPECT_NEAR(t->path.end().yaw, 0.0, 1e-3);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "pullout/geometry/angle.hpp"
 #include "pullout/model/types.hpp"
 
 namespace pullout::test {
@@ -56,16 +57,16 @@ inline PullOutRequest curved_road_request() {
   Lane shoulder_straight = straight_lane(11, LaneSubtype::kRoadShoulder, -30, 0, -4.75, -1.75);
   Lane road_arc;
   road_arc.id = 2;
-  road_arc.left_bound = arc_points(0, R, R - 1.75, -M_PI / 2, 0.0, 1.0);
-  road_arc.right_bound = arc_points(0, R, R + 1.75, -M_PI / 2, 0.0, 1.0);
+  road_arc.left_bound = arc_points(0, R, R - 1.75, -kPi / 2, 0.0, 1.0);
+  road_arc.right_bound = arc_points(0, R, R + 1.75, -kPi / 2, 0.0, 1.0);
   Lane shoulder_arc;
   shoulder_arc.id = 12;
   shoulder_arc.subtype = LaneSubtype::kRoadShoulder;
-  shoulder_arc.left_bound = arc_points(0, R, R + 1.75, -M_PI / 2, 0.0, 1.0);
-  shoulder_arc.right_bound = arc_points(0, R, R + 4.75, -M_PI / 2, 0.0, 1.0);
+  shoulder_arc.left_bound = arc_points(0, R, R + 1.75, -kPi / 2, 0.0, 1.0);
+  shoulder_arc.right_bound = arc_points(0, R, R + 4.75, -kPi / 2, 0.0, 1.0);
   r.lanes = {road_straight, road_arc, shoulder_straight, shoulder_arc};
   r.ego_pose = {-20.0, -3.25, 0.0};
-  r.goal_pose = {R, R, M_PI / 2};
+  r.goal_pose = {R, R, kPi / 2};
   return r;
 }
 

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pullout/geometry/angle.hpp"
 #include "pullout/maps/lanelet_map.hpp"
 
 namespace pullout {
@@ -138,11 +139,11 @@ TEST(Scenario, AllFieldsAndOverrides) {
   EXPECT_DOUBLE_EQ(s.vehicle.wheel_tread_m, 1.7);  // from the base config
   EXPECT_DOUBLE_EQ(s.request.ego_pose.yaw, 0.1);
   EXPECT_DOUBLE_EQ(s.request.ego_velocity_mps, 0.2);
-  EXPECT_NEAR(s.request.goal_pose.yaw, M_PI / 2.0, 1e-12);
+  EXPECT_NEAR(s.request.goal_pose.yaw, kPi / 2.0, 1e-12);
   ASSERT_EQ(s.request.objects.size(), 2u);
   EXPECT_EQ(s.request.objects[0].id, 7);
   EXPECT_EQ(s.request.objects[0].object_class, ObjectClass::kCar);
-  EXPECT_NEAR(s.request.objects[0].pose.yaw, M_PI, 1e-12);
+  EXPECT_NEAR(s.request.objects[0].pose.yaw, kPi, 1e-12);
   EXPECT_DOUBLE_EQ(s.request.objects[0].length_m, 4.0);
   EXPECT_DOUBLE_EQ(s.request.objects[0].velocity_mps, 0.5);
   EXPECT_EQ(s.request.objects[1].object_class, ObjectClass::kPedestrian);

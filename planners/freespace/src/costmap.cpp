@@ -174,10 +174,6 @@ void Costmap::add_obstacles(const std::vector<Polygon>& polygons) {
   precompute();
 }
 
-std::size_t Costmap::occupied_count() const {
-  return static_cast<std::size_t>(std::count_if(occupied_.begin(), occupied_.end(), [](auto v) { return v != 0; }));
-}
-
 Vec2 Costmap::to_grid(const Vec2& p) const {
   const double dx = p.x() - origin_.x;
   const double dy = p.y() - origin_.y;

@@ -5,24 +5,16 @@
 #include <cmath>
 
 #include "pullout/freespace/grid_collision_checker.hpp"
+#include "pullout/geometry/angle.hpp"
+#include "pullout/geometry/polyline.hpp"
 
 namespace pullout {
 
 namespace {
 
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kTrimDistance = 1.0;  // [m] Autoware's trim around the end pose
 constexpr double kSamePose = 1e-6;     // [m]
 constexpr double kWindowExtra = 10.0;  // [m] costmap window beyond the farthest end pose
-
-double path_length(const PathWithLaneId& path) {
-  double len = 0.0;
-  for (std::size_t i = 1; i < path.points.size(); ++i) {
-    len += std::hypot(path.points[i].pose.x - path.points[i - 1].pose.x,
-                      path.points[i].pose.y - path.points[i - 1].pose.y);
-  }
-  return len;
-}
 
 // The pair of a partial path that stops at its end: v reached at half of it (a = v^2 / L).
 TerminalVelocityAccel stopping_pair(double v, double length) {
@@ -109,7 +101,7 @@ SplitPath split_at_cusps(const std::vector<Waypoint>& w, double velocity) {
       pt.longitudinal_velocity_mps = k == i ? 0.0 : dir * velocity;
       part.points.push_back(std::move(pt));
     }
-    out.pairs.push_back(stopping_pair(dir * velocity, path_length(part)));
+    out.pairs.push_back(stopping_pair(dir * velocity, polyline_length(part)));
     out.partial_paths.push_back(std::move(part));
     out.directions.push_back(dir);
     first = i;
@@ -224,7 +216,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
       for (auto& pt : tail) forward.points.push_back(std::move(pt));
       if (forward.points.size() < 2) forward.points.push_back(forward.points.back());
       // The last partial path accelerates to the freespace velocity over its freespace part.
-      const double len = std::max(1e-3, path_length(forward));
+      const double len = std::max(1e-3, polyline_length(forward));
       split.pairs.back() = {fp.velocity, fp.velocity * fp.velocity / (2.0 * len)};
       PullOutPath path;
       for (auto& part : split.partial_paths) {

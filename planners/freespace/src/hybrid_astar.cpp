@@ -5,6 +5,7 @@
 #include <queue>
 
 #include "pullout/freespace/reeds_shepp.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "search_support.hpp"
 
 namespace pullout {
@@ -13,7 +14,6 @@ namespace fd = freespace_detail;
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
 constexpr std::size_t kStopCheckInterval = 16;    // expansions between checks of the stop condition
 constexpr int kShotCandidates = 3;                // Reeds-Shepp words tried per shot, cheapest first
 constexpr double kShotDistancePerInterval = 4.0;  // [m] heuristic distance per expansion between shots
@@ -21,12 +21,6 @@ constexpr double kReedsSheppRange = 4.0;          // [turning radii] see heurist
 constexpr double kCoarseSpacing = 1.0;            // [m] first-pass sample spacing of a shot
 constexpr double kSweepGrowth = 0.5;              // [cells] footprint growth between tested poses
 constexpr double kFineSweepGrowth = 0.125;        // [cells] the same where kSweepGrowth refuses
-
-double wrap(double a) {
-  a = std::fmod(a + kTwoPi / 2.0, kTwoPi);
-  if (a < 0.0) a += kTwoPi;
-  return a - kTwoPi / 2.0;
-}
 
 struct Node {
   Pose2 pose;
@@ -150,7 +144,7 @@ class Search {
     const auto ix = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(g.x())) + (1 << 20));
     const auto iy = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(g.y())) + (1 << 20));
     const double bin = kTwoPi / config_.theta_size;
-    auto it = static_cast<std::int64_t>(std::floor((wrap(p.yaw) + kTwoPi / 2.0) / bin));
+    auto it = static_cast<std::int64_t>(std::floor((normalize_angle(p.yaw) + kPi) / bin));
     it = ((it % config_.theta_size) + config_.theta_size) % config_.theta_size;
     return (ix << 42) | (iy << 20) | static_cast<std::uint64_t>(it);
   }
@@ -177,7 +171,7 @@ class Search {
     const double lat = -s * dx + c * dy;
     return std::abs(lon) <= 0.5 * config_.longitudinal_goal_range &&
            std::abs(lat) <= 0.5 * config_.lateral_goal_range &&
-           std::abs(wrap(p.yaw - goal_.yaw)) <= 0.5 * config_.angle_goal_range;
+           std::abs(normalize_angle(p.yaw - goal_.yaw)) <= 0.5 * config_.angle_goal_range;
   }
 
   // Adds a node unless its lattice cell holds a cheaper one; pushes it on the open list.

@@ -9,6 +9,7 @@
 // and for the families that are not symmetric in time, the "backwards" goal
 // (x cos phi + y sin phi, x sin phi - y cos phi, phi) solves the word read in reverse order.
 #include "pullout/freespace/reeds_shepp.hpp"
+#include "pullout/geometry/angle.hpp"
 
 #include <cmath>
 #include <limits>
@@ -17,7 +18,6 @@ namespace pullout {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kHalfPi = kPi / 2.0;
 constexpr double kTolerance = 1e-10;
 
@@ -26,17 +26,6 @@ using Kind = ReedsSheppSegment::Kind;
 constexpr Kind L = Kind::kLeft;      // NOLINT(readability-identifier-naming)
 constexpr Kind S = Kind::kStraight;  // NOLINT(readability-identifier-naming)
 constexpr Kind R = Kind::kRight;     // NOLINT(readability-identifier-naming)
-
-// Angle wrapped into [-pi, pi].
-double wrap(double a) {
-  double v = std::fmod(a, 2.0 * kPi);
-  if (v < -kPi) {
-    v += 2.0 * kPi;
-  } else if (v > kPi) {
-    v -= 2.0 * kPi;
-  }
-  return v;
-}
 
 void polar(double x, double y, double& r, double& theta) {
   r = std::hypot(x, y);
@@ -57,7 +46,7 @@ bool lp_sp_lp(double x, double y, double phi, Lengths& out) {
   double t = 0.0;
   polar(x - std::sin(phi), y - 1.0 + std::cos(phi), u, t);
   if (t < -kTolerance) return false;
-  const double v = wrap(phi - t);
+  const double v = normalize_angle(phi - t);
   if (v < -kTolerance) return false;
   out = {{t, u, v}, 3};
   return true;
@@ -71,8 +60,8 @@ bool lp_sp_rp(double x, double y, double phi, Lengths& out) {
   const double u1_sq = u1 * u1;
   if (u1_sq < 4.0) return false;
   const double u = std::sqrt(u1_sq - 4.0);
-  const double t = wrap(t1 + std::atan2(2.0, u));
-  const double v = wrap(t - phi);
+  const double t = normalize_angle(t1 + std::atan2(2.0, u));
+  const double v = normalize_angle(t - phi);
   if (t < -kTolerance || v < -kTolerance) return false;
   out = {{t, u, v}, 3};
   return true;
@@ -87,8 +76,8 @@ bool lp_rm_l(double x, double y, double phi, Lengths& out) {
   polar(xi, eta, u1, theta);
   if (u1 > 4.0) return false;
   const double u = -2.0 * std::asin(0.25 * u1);
-  const double t = wrap(theta + 0.5 * u + kPi);
-  const double v = wrap(phi - t + u);
+  const double t = normalize_angle(theta + 0.5 * u + kPi);
+  const double v = normalize_angle(phi - t + u);
   if (t < -kTolerance || u > kTolerance) return false;
   out = {{t, u, v}, 3};
   return true;
@@ -96,13 +85,13 @@ bool lp_rm_l(double x, double y, double phi, Lengths& out) {
 
 // The two headings of the CCCC words (section 8, formulas 8.7 and 8.8).
 void tau_omega(double u, double v, double xi, double eta, double phi, double& tau, double& omega) {
-  const double delta = wrap(u - v);
+  const double delta = normalize_angle(u - v);
   const double a = std::sin(u) - std::sin(delta);
   const double b = std::cos(u) - std::cos(delta) - 1.0;
   const double t1 = std::atan2(eta * a - xi * b, xi * a + eta * b);
   const double t2 = 2.0 * (std::cos(delta) - std::cos(v) - std::cos(u)) + 3.0;
-  tau = t2 < 0.0 ? wrap(t1 + kPi) : wrap(t1);
-  omega = wrap(tau - u + v - phi);
+  tau = t2 < 0.0 ? normalize_angle(t1 + kPi) : normalize_angle(t1);
+  omega = normalize_angle(tau - u + v - phi);
 }
 
 // 8.7  L+ R+u | L-u R-
@@ -148,8 +137,8 @@ bool lp_rm_sm_lm(double x, double y, double phi, Lengths& out) {
   if (rho < 2.0) return false;
   const double r = std::sqrt(rho * rho - 4.0);
   const double u = 2.0 - r;
-  const double t = wrap(theta + std::atan2(r, -2.0));
-  const double v = wrap(phi - kHalfPi - t);
+  const double t = normalize_angle(theta + std::atan2(r, -2.0));
+  const double v = normalize_angle(phi - kHalfPi - t);
   if (t < -kTolerance || u > kTolerance || v > kTolerance) return false;
   out = {{t, -kHalfPi, u, v}, 4};
   return true;
@@ -165,7 +154,7 @@ bool lp_rm_sm_rm(double x, double y, double phi, Lengths& out) {
   if (rho < 2.0) return false;
   const double t = theta;
   const double u = 2.0 - rho;
-  const double v = wrap(t + kHalfPi - phi);
+  const double v = normalize_angle(t + kHalfPi - phi);
   if (t < -kTolerance || u > kTolerance || v > kTolerance) return false;
   out = {{t, -kHalfPi, u, v}, 4};
   return true;
@@ -181,8 +170,8 @@ bool lp_rm_s_lm_rp(double x, double y, double phi, Lengths& out) {
   if (rho < 2.0) return false;
   const double u = 4.0 - std::sqrt(rho * rho - 4.0);
   if (u > kTolerance) return false;
-  const double t = wrap(std::atan2((4.0 - u) * xi - 2.0 * eta, -2.0 * xi + (u - 4.0) * eta));
-  const double v = wrap(t - phi);
+  const double t = normalize_angle(std::atan2((4.0 - u) * xi - 2.0 * eta, -2.0 * xi + (u - 4.0) * eta));
+  const double v = normalize_angle(t - phi);
   if (t < -kTolerance || v < -kTolerance) return false;
   out = {{t, -kHalfPi, u, -kHalfPi, v}, 5};
   return true;
@@ -257,7 +246,7 @@ void relative(const Pose2& from, const Pose2& to, double radius, double& x, doub
   const double s = std::sin(from.yaw);
   x = (c * dx + s * dy) / radius;
   y = (-s * dx + c * dy) / radius;
-  phi = wrap(to.yaw - from.yaw);
+  phi = normalize_angle(to.yaw - from.yaw);
 }
 
 }  // namespace
@@ -381,7 +370,7 @@ Pose2 ReedsShepp::interpolate(const Pose2& from, const ReedsSheppPath& path, dou
     remaining -= len;
     if (remaining <= 0.0) break;
   }
-  p.yaw = wrap(p.yaw);
+  p.yaw = normalize_angle(p.yaw);
   if (direction != nullptr) *direction = dir;
   return p;
 }

@@ -6,14 +6,21 @@
 
 namespace pullout {
 
-double normalize_angle(double angle) {
-  // Most angles are already in range or one turn off: avoid fmod for them.
-  if (angle >= -M_PI && angle < M_PI) return angle;
-  if (angle >= M_PI && angle < 3.0 * M_PI) return angle - 2.0 * M_PI;
-  if (angle < -M_PI && angle >= -3.0 * M_PI) return angle + 2.0 * M_PI;
-  double a = std::fmod(angle + M_PI, 2.0 * M_PI);
-  if (a < 0.0) a += 2.0 * M_PI;
-  return a - M_PI;
+double polyline_length(const std::vector<Point2>& points) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    length += std::hypot(points[i].x - points[i - 1].x, points[i].y - points[i - 1].y);
+  }
+  return length;
+}
+
+double polyline_length(const PathWithLaneId& path) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < path.points.size(); ++i) {
+    length += std::hypot(path.points[i].pose.x - path.points[i - 1].pose.x,
+                         path.points[i].pose.y - path.points[i - 1].pose.y);
+  }
+  return length;
 }
 
 Vec2 to_local(const Pose2& pose, const Vec2& p) {

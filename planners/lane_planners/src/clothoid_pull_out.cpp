@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pullout/geometry/angle.hpp"
 #include "pullout/lane_planners/two_turn_path.hpp"
 #include "turn_candidate.hpp"
 
@@ -15,12 +16,12 @@ PlannerCandidates ClothoidPullOut::plan(const PlanningContext& ctx, const Pose2&
   const Polyline window = turn_window(ctx, start);
   const double v0 = p.clothoid_initial_velocity;
   const double a = p.clothoid_acceleration;
-  const double rate = p.clothoid_max_steer_angle_rate_deg_per_sec * M_PI / 180.0;
+  const double rate = p.clothoid_max_steer_angle_rate_deg_per_sec * kDegToRad;
   const double v_lane = speed_limit_at(ctx, ctx.road.centerline.project(to_vec(start)).s);
   for (double steer_deg : p.clothoid_max_steer_angles_deg) {
     out.stopped = stop.check();
     if (out.stopped != StopReason::kNone) break;
-    const double steer = steer_deg * M_PI / 180.0;
+    const double steer = steer_deg * kDegToRad;
     PathCandidate candidate;
     if (steer > ctx.vehicle.max_steer_angle_rad) {
       candidate.rejection = Failure{AttemptOutcome::kNoGeometry,

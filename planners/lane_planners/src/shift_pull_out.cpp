@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "pullout/collision/footprint.hpp"
+#include "pullout/geometry/angle.hpp"
 
 namespace pullout {
 
@@ -221,10 +222,9 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
   }
   const double yaw_dev = normalize_angle(start.yaw - center.yaw_at(s_start));
   if (std::abs(yaw_dev) > kMaxStartYawDeviation) {
-    out.failure =
-        Failure{AttemptOutcome::kStartInvalid, "start heading deviates " + format_fixed(yaw_dev * 180.0 / M_PI, 1) +
-                                                   " deg from the road (limit " +
-                                                   format_fixed(kMaxStartYawDeviation * 180.0 / M_PI, 0) + ")"};
+    out.failure = Failure{AttemptOutcome::kStartInvalid,
+                          "start heading deviates " + format_fixed(yaw_dev * kRadToDeg, 1) +
+                              " deg from the road (limit " + format_fixed(kMaxStartYawDeviation * kRadToDeg, 0) + ")"};
     return out;
   }
   const RoadEnd end = find_path_end(ctx, s_start);

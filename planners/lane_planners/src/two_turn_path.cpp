@@ -1,4 +1,5 @@
 #include "pullout/lane_planners/two_turn_path.hpp"
+#include "pullout/geometry/angle.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -47,9 +48,9 @@ Evaluation evaluate(const Pose2& start, double d1, double psi_target, const Poly
 // 2R(1 - cos d) + l sin d, increasing in d on [0, pi/2]. Returns d for |offset|, or nullopt.
 std::optional<double> arc_s_curve_angle(double offset, double radius, double straight) {
   const auto disp = [&](double d) { return 2.0 * radius * (1.0 - std::cos(d)) + straight * std::sin(d); };
-  if (disp(M_PI / 2) < offset) return std::nullopt;
+  if (disp(kPi / 2) < offset) return std::nullopt;
   double lo = 0.0;
-  double hi = M_PI / 2;
+  double hi = kPi / 2;
   for (int i = 0; i < 50; ++i) {
     const double mid = 0.5 * (lo + hi);
     (disp(mid) < offset ? lo : hi) = mid;
@@ -96,12 +97,12 @@ std::optional<TwoTurnPath> solve_two_turn(const Pose2& start, const Polyline& ce
     if (std::abs(dpsi) < kParallelStart) {
       // Bracket from the closed form for arcs of the same peak curvature: clothoid turns need a
       // slightly larger angle, so expand until the sign changes.
-      const double guess = arc_s_curve_angle(std::abs(offset), 1.0 / spec.kappa, spec.straight).value_or(M_PI / 2);
+      const double guess = arc_s_curve_angle(std::abs(offset), 1.0 / spec.kappa, spec.straight).value_or(kPi / 2);
       const double fa = f(0.0);
       double b = std::max(guess * 1.2, 1e-3);
       double fb = f(towards * b);
-      for (int k = 0; k < 6 && (fb > 0.0) == (fa > 0.0) && b < M_PI / 2; ++k) {
-        b = std::min(b * 1.3, M_PI / 2);
+      for (int k = 0; k < 6 && (fb > 0.0) == (fa > 0.0) && b < kPi / 2; ++k) {
+        b = std::min(b * 1.3, kPi / 2);
         fb = f(towards * b);
       }
       if ((fb > 0.0) != (fa > 0.0)) root = refine(f, 0.0, fa, towards * b, fb);
@@ -109,7 +110,7 @@ std::optional<TwoTurnPath> solve_two_turn(const Pose2& start, const Polyline& ce
       // General start heading: scan d1 over the turns that keep moving forward and keep the root
       // with the least total turning.
       constexpr int kSteps = 24;
-      const double range = std::min(M_PI, M_PI / 2 + std::abs(dpsi));
+      const double range = std::min(kPi, kPi / 2 + std::abs(dpsi));
       double best_turn = 1e9;
       double a = -range;
       double fa = f(a);

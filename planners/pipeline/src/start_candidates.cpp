@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pullout/collision/footprint.hpp"
+#include "pullout/geometry/angle.hpp"
 
 namespace pullout {
 
@@ -28,7 +29,7 @@ LanePosition lane_position(const LaneChain& lanes, const Pose2& ego) {
 Pose2 backed_pose(const LaneChain& lanes, const LanePosition& at, double back) {
   const Pose2 base = lanes.centerline.pose_at(at.s - at.facing * back);
   const Vec2 p = to_vec(base) + left_normal(heading(base.yaw)) * at.lateral;
-  return {p.x(), p.y(), at.facing > 0.0 ? base.yaw : normalize_angle(base.yaw + M_PI)};
+  return {p.x(), p.y(), at.facing > 0.0 ? base.yaw : normalize_angle(base.yaw + kPi)};
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "pullout/geometry/polyline.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "validation.hpp"
@@ -13,7 +14,6 @@ namespace pullout {
 
 namespace {
 
-constexpr std::size_t kMaxVehicleIdLength = 256;
 constexpr double kMinBoundLength = 0.1;  // [m]
 constexpr double kMinLaneArea = 1e-2;    // [m^2]
 
@@ -59,12 +59,6 @@ class Checker {
   std::vector<RequestIssue>& issues_;
 };
 
-double line_length(const std::vector<Point2>& pts) {
-  double len = 0.0;
-  for (std::size_t i = 1; i < pts.size(); ++i) len += std::hypot(pts[i].x - pts[i - 1].x, pts[i].y - pts[i - 1].y);
-  return len;
-}
-
 double lane_area(const Lane& lane) {
   double twice = 0.0;
   std::vector<Point2> ring = lane.left_bound;
@@ -87,7 +81,7 @@ void validate_lane(Checker& c, const std::string& f, const Lane& lane) {
       ok = false;
     } else if (!c.points(lf, *line)) {
       ok = false;
-    } else if (line_length(*line) < kMinBoundLength) {
+    } else if (polyline_length(*line) < kMinBoundLength) {
       c.add(lf, "degenerate: shorter than " + std::to_string(kMinBoundLength) + " m");
       ok = false;
     }
@@ -141,8 +135,8 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
   std::vector<RequestIssue> issues;
   Checker c(limits, issues);
   if (r.vehicle_id.empty()) c.add("vehicle_id", "empty");
-  if (r.vehicle_id.size() > kMaxVehicleIdLength) {
-    c.add("vehicle_id", "longer than " + std::to_string(kMaxVehicleIdLength) + " characters");
+  if (r.vehicle_id.size() > kMaxVehicleIdBytes) {
+    c.add("vehicle_id", "longer than " + std::to_string(kMaxVehicleIdBytes) + " bytes");
   }
   c.pose("ego_pose", r.ego_pose);
   c.finite("ego_velocity_mps", r.ego_velocity_mps);

@@ -9,12 +9,12 @@
 
 #include "pullout/collision/footprint.hpp"
 #include "pullout/freespace/costmap.hpp"
+#include "pullout/geometry/angle.hpp"
 
 namespace pullout {
 
 namespace {
 
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr long kMaxCells = 64L * 1024L * 1024L;
 
 // The next header token of a PGM file, skipping whitespace and '#' comments.

@@ -10,6 +10,7 @@
 #include "config/config_detail.hpp"
 #include "config/grid_file.hpp"
 #include "config/yaml_fields.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/maps/osm_loader.hpp"
 #include "pullout/model/names.hpp"
 
@@ -19,7 +20,6 @@ namespace {
 using yaml_fields::MapReader;
 using yaml_fields::Problems;
 
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 // Scenario requests carry a fixed id: a client sending one assigns its own.
 constexpr std::uint64_t kScenarioRequestId = 1;
 

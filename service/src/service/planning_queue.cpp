@@ -48,11 +48,6 @@ void PlanningQueue::stop() {
   workers_.clear();
 }
 
-std::size_t PlanningQueue::waiting() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return waiting_.size();
-}
-
 void PlanningQueue::worker_loop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {

@@ -52,8 +52,6 @@ class PlanningQueue {
   // first to make this quick). Idempotent.
   void stop();
 
-  std::size_t waiting() const;
-
  private:
   void worker_loop();
 

@@ -14,6 +14,7 @@
 
 #include "pullout/idl/convert.hpp"
 #include "pullout/model/names.hpp"
+#include "pullout/model/types.hpp"
 
 namespace pullout::service {
 namespace dds = eprosima::fastdds::dds;
@@ -27,8 +28,6 @@ namespace {
 const eprosima::fastrtps::Duration_t kDispatcherWakePeriod{0, 250'000'000};
 constexpr auto kSessionTimePeriod = std::chrono::milliseconds(250);
 constexpr auto kProgressWarnInterval = std::chrono::seconds(5);
-// Must match the generated key buffer (see convert.cpp): replies to a longer id cannot be written.
-constexpr std::size_t kMaxVehicleIdBytes = 255;
 
 const char* outcome_name(PlanningResult::Outcome o) {
   switch (o) {

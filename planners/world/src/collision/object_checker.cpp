@@ -109,7 +109,6 @@ ObjectChecker::~ObjectChecker() = default;
 ObjectChecker::ObjectChecker(ObjectChecker&&) noexcept = default;
 ObjectChecker& ObjectChecker::operator=(ObjectChecker&&) noexcept = default;
 
-std::size_t ObjectChecker::obstacle_count() const { return impl_->obstacles.size(); }
 const Footprint& ObjectChecker::footprint() const { return impl_->footprint; }
 
 ObjectChecker::Clearance ObjectChecker::clearance(const Pose2& pose, double horizon) const {

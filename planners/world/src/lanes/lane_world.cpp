@@ -4,8 +4,6 @@
 #include <cmath>
 #include <unordered_set>
 
-#include "pullout/geometry/grid_cell.hpp"
-
 namespace pullout {
 
 namespace {
@@ -126,35 +124,10 @@ void LaneWorld::build_topology() {
   }
 }
 
-template <typename F>
-void LaneWorld::for_cells(const Aabb& box, F&& f) const {
-  const std::int64_t x0 = cell_index(box.min.x(), cell_size_);
-  const std::int64_t x1 = cell_index(box.max.x(), cell_size_);
-  const std::int64_t y0 = cell_index(box.min.y(), cell_size_);
-  const std::int64_t y1 = cell_index(box.max.y(), cell_size_);
-  for (std::int64_t ix = x0; ix <= x1; ++ix) {
-    for (std::int64_t iy = y0; iy <= y1; ++iy) f(cell_key(ix, iy));
-  }
-}
-
-double LaneWorld::cell_count(const Aabb& box) const {
-  // In double: the clamped indices span up to 2^31 cells each way.
-  const auto span = [this](double lo, double hi) {
-    return static_cast<double>(cell_index(hi, cell_size_) - cell_index(lo, cell_size_) + 1);
-  };
-  return span(box.min.x(), box.max.x()) * span(box.min.y(), box.max.y());
-}
-
 void LaneWorld::build_index() {
   for (std::size_t i = 0; i < lanes_.size(); ++i) {
     for (std::size_t k = 0; k < lanes_[i].pieces.size(); ++k) {
-      if (cell_count(lanes_[i].piece_boxes[k]) > kMaxIndexedCells) {
-        wide_pieces_.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k));
-        continue;
-      }
-      for_cells(lanes_[i].piece_boxes[k], [&](std::uint64_t key) {
-        lane_cells_[key].emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k));
-      });
+      piece_index_.insert(lanes_[i].piece_boxes[k], {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
     }
   }
   // An edge piece belongs to the outline of the union unless the point just outside it lies in
@@ -194,11 +167,7 @@ void LaneWorld::build_index() {
     Aabb box;
     box.extend(outer_edges_[e].first);
     box.extend(outer_edges_[e].second);
-    if (cell_count(box) > kMaxIndexedCells) {
-      wide_edges_.push_back(static_cast<std::uint32_t>(e));
-      continue;
-    }
-    for_cells(box, [&](std::uint64_t key) { edge_cells_[key].push_back(static_cast<std::uint32_t>(e)); });
+    edge_index_.insert(box, static_cast<std::uint32_t>(e));
   }
 }
 
@@ -208,16 +177,8 @@ bool LaneWorld::any_piece_containing(const Vec2& p, F&& accept) const {
     const LaneGeometry& g = lanes_[lane];
     return g.piece_boxes[piece].contains(p) && point_in_polygon(g.pieces[piece], p) && accept(lane);
   };
-  const auto it = lane_cells_.find(cell_key(cell_index(p.x(), cell_size_), cell_index(p.y(), cell_size_)));
-  if (it != lane_cells_.end()) {
-    for (const auto& [lane, piece] : it->second) {
-      if (test(lane, piece)) return true;
-    }
-  }
-  for (const auto& [lane, piece] : wide_pieces_) {
-    if (test(lane, piece)) return true;
-  }
-  return false;
+  return piece_index_.any_at(p,
+                             [&](const std::pair<std::uint32_t, std::uint32_t>& v) { return test(v.first, v.second); });
 }
 
 std::vector<std::size_t> LaneWorld::lanes_containing(const Vec2& p) const {
@@ -297,21 +258,8 @@ bool LaneWorld::footprint_inside(const std::array<Vec2, 4>& corners) const {
     }
     return false;
   };
-  bool crosses = false;
-  for_cells(box, [&](std::uint64_t key) {
-    if (crosses) return;
-    const auto it = edge_cells_.find(key);
-    if (it == edge_cells_.end()) return;
-    // An edge spanning several cells is tested once per cell: cheaper than remembering it.
-    for (std::uint32_t e : it->second) {
-      if (crosses_edge(e)) {
-        crosses = true;
-        return;
-      }
-    }
-  });
-  for (std::size_t i = 0; i < wide_edges_.size() && !crosses; ++i) crosses = crosses_edge(wide_edges_[i]);
-  return !crosses;
+  // An edge spanning several cells is tested once per cell: cheaper than remembering it.
+  return !edge_index_.any_in(box, crosses_edge);
 }
 
 }  // namespace pullout

@@ -6,21 +6,15 @@
 #include <map>
 #include <utility>
 
-#include "pullout/geometry/grid_cell.hpp"
+#include "pullout/geometry/polyline.hpp"
 
 namespace pullout {
 
 namespace {
 
-double line_length(const std::vector<Point2>& pts) {
-  double len = 0.0;
-  for (std::size_t i = 1; i < pts.size(); ++i) len += std::hypot(pts[i].x - pts[i - 1].x, pts[i].y - pts[i - 1].y);
-  return len;
-}
-
 // The point at half the arc length of a line.
 Point2 middle_of(const std::vector<Point2>& pts) {
-  const double half = 0.5 * line_length(pts);
+  const double half = 0.5 * polyline_length(pts);
   double s = 0.0;
   for (std::size_t i = 1; i < pts.size(); ++i) {
     const double seg = std::hypot(pts[i].x - pts[i - 1].x, pts[i].y - pts[i - 1].y);
@@ -97,30 +91,23 @@ bool inside(const std::vector<Point2>& ring, const Point2& p) {
   return in;
 }
 
-double box_distance(const Box2& b, const Point2& p) {
-  const double dx = std::max({b.min_x - p.x, 0.0, p.x - b.max_x});
-  const double dy = std::max({b.min_y - p.y, 0.0, p.y - b.max_y});
+double box_distance(const Aabb& b, const Point2& p) {
+  const double dx = std::max({b.min.x() - p.x, 0.0, p.x - b.max.x()});
+  const double dy = std::max({b.min.y() - p.y, 0.0, p.y - b.max.y()});
   return std::hypot(dx, dy);
 }
 
 }  // namespace
 
-LaneletMap::LaneletMap(std::vector<Lanelet> lanelets, LaneletMapInfo info)
-    : lanelets_(std::move(lanelets)), info_(info) {
+LaneletMap::LaneletMap(std::vector<Lanelet> lanelets) : lanelets_(std::move(lanelets)) {
   for (std::size_t i = 0; i < lanelets_.size(); ++i) {
     Lanelet& ll = lanelets_[i];
     align(ll);
-    ll.length_m = 0.5 * (line_length(ll.left.points) + line_length(ll.right.points));
+    ll.length_m = 0.5 * (polyline_length(ll.left.points) + polyline_length(ll.right.points));
     ll.polygon = ll.left.points;
     ll.polygon.insert(ll.polygon.end(), ll.right.points.rbegin(), ll.right.points.rend());
-    ll.box = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-              -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-    for (const Point2& p : ll.polygon) {
-      ll.box.min_x = std::min(ll.box.min_x, p.x);
-      ll.box.min_y = std::min(ll.box.min_y, p.y);
-      ll.box.max_x = std::max(ll.box.max_x, p.x);
-      ll.box.max_y = std::max(ll.box.max_y, p.y);
-    }
+    ll.box = Aabb{};
+    for (const Point2& p : ll.polygon) ll.box.extend(to_vec(p));
     ll.successors.clear();
     ll.predecessors.clear();
     ll.left_neighbours.clear();
@@ -167,20 +154,9 @@ void LaneletMap::build_topology() {
   }
 }
 
-template <typename F>
-void LaneletMap::for_cells(const Box2& box, F&& f) const {
-  const std::int64_t x0 = cell_index(box.min_x, cell_size_);
-  const std::int64_t x1 = cell_index(box.max_x, cell_size_);
-  const std::int64_t y0 = cell_index(box.min_y, cell_size_);
-  const std::int64_t y1 = cell_index(box.max_y, cell_size_);
-  for (std::int64_t ix = x0; ix <= x1; ++ix) {
-    for (std::int64_t iy = y0; iy <= y1; ++iy) f(cell_key(ix, iy));
-  }
-}
-
 void LaneletMap::build_index() {
   for (std::size_t i = 0; i < lanelets_.size(); ++i) {
-    for_cells(lanelets_[i].box, [&](std::uint64_t key) { cells_[key].push_back(static_cast<std::uint32_t>(i)); });
+    index_.insert(lanelets_[i].box, static_cast<std::uint32_t>(i));
   }
 }
 
@@ -198,12 +174,11 @@ std::size_t LaneletMap::count(LaneletSubtype subtype) const {
 std::vector<std::size_t> LaneletMap::lanelets_containing(const Point2& p) const {
   std::vector<std::size_t> out;
   if (!std::isfinite(p.x) || !std::isfinite(p.y)) return out;
-  const auto it = cells_.find(cell_key(cell_index(p.x, cell_size_), cell_index(p.y, cell_size_)));
-  if (it == cells_.end()) return out;
-  for (std::uint32_t i : it->second) {
+  index_.any_at(to_vec(p), [&](std::uint32_t i) {
     const Lanelet& ll = lanelets_[i];
     if (box_distance(ll.box, p) == 0.0 && inside(ll.polygon, p)) out.push_back(i);
-  }
+    return false;
+  });
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -221,20 +196,16 @@ double LaneletMap::distance_to(std::size_t index, const Point2& p) const {
 std::vector<std::size_t> LaneletMap::lanelets_near(const Point2& p, double radius) const {
   std::vector<std::size_t> candidates;
   if (!(radius >= 0.0) || !std::isfinite(radius) || !std::isfinite(p.x) || !std::isfinite(p.y)) return candidates;
-  const Box2 query{p.x - radius, p.y - radius, p.x + radius, p.y + radius};
-  const double cells_across = std::ceil(2.0 * radius / cell_size_) + 1.0;
-  if (cells_across * cells_across > static_cast<double>(cells_.size())) {
+  const Aabb query = Aabb{to_vec(p), to_vec(p)}.inflated(radius);
+  if (index_.cell_count(query) > static_cast<double>(index_.occupied_cells())) {
     // A query wider than the map: looking at every lanelet is cheaper than at every cell.
     for (std::size_t i = 0; i < lanelets_.size(); ++i) {
       if (box_distance(lanelets_[i].box, p) <= radius) candidates.push_back(i);
     }
   } else {
-    for_cells(query, [&](std::uint64_t key) {
-      const auto it = cells_.find(key);
-      if (it == cells_.end()) return;
-      for (std::uint32_t i : it->second) {
-        if (box_distance(lanelets_[i].box, p) <= radius) candidates.push_back(i);
-      }
+    index_.any_in(query, [&](std::uint32_t i) {
+      if (box_distance(lanelets_[i].box, p) <= radius) candidates.push_back(i);
+      return false;
     });
   }
   // A lanelet spanning several cells is listed once per cell.

@@ -126,7 +126,7 @@ class Loader {
     std::vector<Lanelet> lanelets = read_lanelets(root);
     if (lanelets.empty() && problems_.empty()) problems_.push_back("no lanelet (a relation with type=lanelet)");
     if (!problems_.empty()) fail(std::move(problems_));
-    return std::make_shared<const LaneletMap>(std::move(lanelets), info_);
+    return std::make_shared<const LaneletMap>(std::move(lanelets));
   }
 
  private:
@@ -145,7 +145,6 @@ class Loader {
 
   void read_nodes(const pugi::xml_node& root) {
     for (const pugi::xml_node& n : root.children("node")) {
-      ++info_.nodes;
       const auto id = parse_id(n.attribute("id").value());
       if (!id) {
         problem(std::string("node") + where(n) + ": id '" + n.attribute("id").value() + "' is not an integer");
@@ -192,7 +191,6 @@ class Loader {
 
   void read_ways(const pugi::xml_node& root) {
     for (const pugi::xml_node& w : root.children("way")) {
-      ++info_.ways;
       const auto id = parse_id(w.attribute("id").value());
       if (!id) {
         problem(std::string("way") + where(w) + ": id '" + w.attribute("id").value() + "' is not an integer");
@@ -220,11 +218,9 @@ class Loader {
       for (auto& [id, node] : nodes_) node.xy = {node.local_x, node.local_y};
       return;
     }
-    info_.projected = true;
+    projected_ = true;
     if (!first_geo_node_) return;  // every lanelet's bounds will report their nodes
     const RawNode& origin = nodes_.at(*first_geo_node_);
-    info_.origin_lat_deg = origin.lat;
-    info_.origin_lon_deg = origin.lon;
     const GeographicLib::LocalCartesian projection(origin.lat, origin.lon, 0.0);
     for (auto& [id, node] : nodes_) {
       if (!node.has_geo) continue;
@@ -256,7 +252,7 @@ class Loader {
         problem(what + ": node " + std::to_string(ref) + " is not in the file");
         return std::nullopt;
       }
-      if (info_.projected && !n->second.has_geo) {
+      if (projected_ && !n->second.has_geo) {
         problem(what + ": node " + std::to_string(ref) + " has neither local_x/local_y nor lat/lon");
         return std::nullopt;
       }
@@ -278,7 +274,6 @@ class Loader {
     std::vector<Lanelet> out;
     std::unordered_set<std::int64_t> relation_ids;
     for (const pugi::xml_node& r : root.children("relation")) {
-      ++info_.relations;
       const auto id = parse_id(r.attribute("id").value());
       if (!id) {
         problem(std::string("relation") + where(r) + ": id '" + r.attribute("id").value() + "' is not an integer");
@@ -292,7 +287,6 @@ class Loader {
       for (const pugi::xml_node& tag : r.children("tag")) tags[tag.attribute("k").value()] = tag.attribute("v").value();
       const auto type = tags.find("type");
       if (type == tags.end() || type->second != "lanelet") continue;
-      ++info_.lanelet_relations;
       if (auto ll = read_lanelet(*id, r, tags)) out.push_back(std::move(*ll));
     }
     if (problems_beyond_ > 0) problems_.push_back("... " + std::to_string(problems_beyond_) + " more not listed");
@@ -384,7 +378,7 @@ class Loader {
   std::unordered_set<std::int64_t> bad_ways_;
   std::optional<std::int64_t> first_geo_node_;
   bool all_local_{true};
-  LaneletMapInfo info_;
+  bool projected_{false};  // the nodes had no local_x/local_y: lat/lon were projected
   std::vector<std::string> problems_;
   std::size_t problems_beyond_{0};
 };

@@ -53,7 +53,6 @@ class Costmap {
   int height() const { return height_; }
   double resolution() const { return resolution_; }
   const Pose2& origin() const { return origin_; }
-  std::size_t occupied_count() const;
 
   // Cell occupancy; outside the grid is occupied.
   bool occupied(int ix, int iy) const {

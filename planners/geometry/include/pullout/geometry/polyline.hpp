@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "pullout/geometry/angle.hpp"
 #include "pullout/model/types.hpp"
 
 namespace pullout {
@@ -18,8 +19,10 @@ inline Point2 to_point(const Vec2& v) { return {v.x(), v.y()}; }
 inline Vec2 heading(double yaw);  // unit vector
 inline Vec2 left_normal(const Vec2& unit) { return {-unit.y(), unit.x()}; }
 
-// Wraps to [-pi, pi).
-double normalize_angle(double angle);
+// Length [m] of the line through `points` in order (0 with fewer than two points).
+double polyline_length(const std::vector<Point2>& points);
+// Length [m] of the line through the positions of a path's points, in order.
+double polyline_length(const PathWithLaneId& path);
 
 // Position of point p in the frame of `pose`: (longitudinal, lateral-left) [m].
 Vec2 to_local(const Pose2& pose, const Vec2& p);

@@ -9,12 +9,18 @@
 // name says otherwise.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace pullout {
+
+// The longest vehicle_id [bytes] the system accepts: the generated DDS type support serializes the
+// key (vehicle_id) into a fixed 4 + 255 + 1 byte buffer, so a reply to a longer id cannot be
+// written. Client, conversion, service and validation all check against this one value.
+inline constexpr std::size_t kMaxVehicleIdBytes = 255;
 
 struct Point2 {
   double x{0.0};  // [m]

@@ -49,7 +49,6 @@ class ObjectChecker {
   };
   std::optional<Hit> first_hit(const std::vector<Pose2>& poses, double margin) const;
 
-  std::size_t obstacle_count() const;
   const Footprint& footprint() const;
 
  private:

@@ -10,9 +10,9 @@
 #include <array>
 #include <cstdint>
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
+#include "pullout/geometry/grid_index.hpp"
 #include "pullout/geometry/polygon.hpp"
 #include "pullout/geometry/polyline.hpp"
 #include "pullout/model/types.hpp"
@@ -79,25 +79,17 @@ class LaneWorld {
   void build_topology();
   void build_index();
   bool inside_other_lane(const Vec2& p, std::size_t lane) const;
-  template <typename F>
-  void for_cells(const Aabb& box, F&& f) const;
 
   std::vector<LaneGeometry> lanes_;
   // Pieces of lane edges that are not shared with a neighbouring lane: the outline of the union.
   std::vector<std::pair<Vec2, Vec2>> outer_edges_;
-  double cell_size_{4.0};  // [m] cells of the index: pullout/geometry/grid_cell.hpp
-  // Cell -> (lane index, piece index) of the lane pieces overlapping the cell. A piece or edge
-  // whose box covers more than kMaxIndexedCells cells (a long diagonal, far-apart points) is kept
-  // in a list tested on every query instead, so that the index costs what the lanes hold, not
-  // what their coordinates span.
-  static constexpr double kMaxIndexedCells = 4096;
-  std::unordered_map<std::uint64_t, std::vector<std::pair<std::uint32_t, std::uint32_t>>> lane_cells_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> wide_pieces_;
+  static constexpr double kCellSize = 4.0;  // [m] cells of the indexes
+  // (lane index, piece index) of the lane pieces, by the cells their boxes cover.
+  GridIndex<std::pair<std::uint32_t, std::uint32_t>> piece_index_{kCellSize};
   template <typename F>
   bool any_piece_containing(const Vec2& p, F&& accept) const;
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edge_cells_;
-  std::vector<std::uint32_t> wide_edges_;
-  double cell_count(const Aabb& box) const;
+  // Indices into outer_edges_, by the cells their boxes cover.
+  GridIndex<std::uint32_t> edge_index_{kCellSize};
 };
 
 }  // namespace pullout

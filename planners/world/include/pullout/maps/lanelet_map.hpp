@@ -24,19 +24,14 @@
 #include <unordered_map>
 #include <vector>
 
+#include "pullout/geometry/grid_index.hpp"
+#include "pullout/geometry/polygon.hpp"
 #include "pullout/model/types.hpp"
 
 namespace pullout {
 
 enum class LaneletSubtype : std::uint8_t { kRoad = 0, kRoadShoulder = 1, kOther = 2 };
 enum class TurnDirection : std::uint8_t { kNone = 0, kStraight = 1, kLeft = 2, kRight = 3 };
-
-struct Box2 {
-  double min_x{0.0};
-  double min_y{0.0};
-  double max_x{0.0};
-  double max_y{0.0};
-};
 
 // One bound or centerline as read from the map: its OSM way and the node ids at its two ends
 // (after alignment).
@@ -58,7 +53,7 @@ struct Lanelet {
   TurnDirection turn_direction{TurnDirection::kNone};
   double length_m{0.0};         // mean length of the two bounds [m]
   std::vector<Point2> polygon;  // left bound forward, right bound backward
-  Box2 box;
+  Aabb box;
   // Topology: indices into LaneletMap::lanelets().
   std::vector<std::size_t> successors;
   std::vector<std::size_t> predecessors;
@@ -66,28 +61,16 @@ struct Lanelet {
   std::vector<std::size_t> right_neighbours;
 };
 
-// Statistics of what the file held besides lanelets (kept for diagnostics; not used).
-struct LaneletMapInfo {
-  std::size_t nodes{0};
-  std::size_t ways{0};
-  std::size_t relations{0};
-  std::size_t lanelet_relations{0};
-  bool projected{false};       // true when the nodes had no local_x/local_y and lat/lon were projected
-  double origin_lat_deg{0.0};  // the projection origin when projected
-  double origin_lon_deg{0.0};
-};
-
 class LaneletMap {
  public:
   // Aligns the bounds (see the file comment), then derives polygons, boxes, lengths, the topology
   // and the spatial index. Every bound must have at least two points and ids must be unique (the
   // loader checks both); the derived fields and the topology given in `lanelets` are replaced.
-  explicit LaneletMap(std::vector<Lanelet> lanelets, LaneletMapInfo info = {});
+  explicit LaneletMap(std::vector<Lanelet> lanelets);
 
   const std::vector<Lanelet>& lanelets() const { return lanelets_; }
   const Lanelet& lanelet(std::size_t index) const { return lanelets_[index]; }
   std::optional<std::size_t> find(std::int64_t id) const;
-  const LaneletMapInfo& info() const { return info_; }
   std::size_t count(LaneletSubtype subtype) const;
 
   // Indices of the lanelets whose polygon contains p (boundary points may go either way), in
@@ -102,15 +85,11 @@ class LaneletMap {
  private:
   void build_topology();
   void build_index();
-  template <typename F>
-  void for_cells(const Box2& box, F&& f) const;
 
   std::vector<Lanelet> lanelets_;
-  LaneletMapInfo info_;
   std::unordered_map<std::int64_t, std::size_t> by_id_;
-  // Uniform grid over the lanelets' bounding boxes: cell key -> lanelet indices.
-  double cell_size_{16.0};  // [m] cells: pullout/geometry/grid_cell.hpp
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
+  // Lanelet indices by the cells (16 m) their bounding boxes cover.
+  GridIndex<std::uint32_t> index_{16.0};
 };
 
 // The lanelet as an inline lane for the planning core (road and road_shoulder only; nullopt for
