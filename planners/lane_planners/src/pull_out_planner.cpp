@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "pullout/collision/footprint.hpp"
 #include "pullout/model/names.hpp"
@@ -130,8 +132,13 @@ Selection select_candidate(const PlannerCandidates& pc, double margin) {
     std::string text = r.failure.outcome == sel.outcome ? r.failure.detail : to_string(r.failure.outcome);
     if (r.failure.outcome != sel.outcome && !r.failure.detail.empty()) text += ": " + r.failure.detail;
     if (total > 1) {
-      const std::string counted = std::to_string(r.count) + "/" + std::to_string(total) + " candidates";
-      text = text.empty() ? counted : text + " (" + counted + ")";
+      std::string counted = std::to_string(r.count);
+      counted.append("/").append(std::to_string(total)).append(" candidates");
+      if (text.empty()) {
+        text = std::move(counted);
+      } else {
+        text.append(" (").append(counted).append(")");
+      }
     }
     if (text.empty()) continue;
     if (!sel.detail.empty()) sel.detail += "; ";
