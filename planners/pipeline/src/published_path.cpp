@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <vector>
 
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/geometry/polyline.hpp"
+#include "pullout/lane_planners/pull_out_planner.hpp"
 
 namespace pullout {
 
@@ -35,19 +35,11 @@ double stoppable_speed(double room, double limit, const PublishedPathLimits& l) 
   return lo;
 }
 
-std::string fixed(double v, int precision) {
-  std::ostringstream os;
-  os.setf(std::ios::fixed);
-  os.precision(precision);
-  os << v;
-  return os.str();
-}
-
 // Where the path ends when nothing is in the way.
 std::string clear_note(const PathPoint& last, double beyond) {
-  std::string note = "no object on the published path; it ends " + fixed(beyond, 1) + " m beyond the end pose";
+  std::string note = "no object on the published path; it ends " + format_fixed(beyond, 1) + " m beyond the end pose";
   if (std::abs(last.longitudinal_velocity_mps) < 1e-9) return note + ", stopped";
-  return note + " at " + fixed(std::abs(last.longitudinal_velocity_mps), 1) + " m/s (end of the road lanes or " +
+  return note + " at " + format_fixed(std::abs(last.longitudinal_velocity_mps), 1) + " m/s (end of the road lanes or " +
          "forward_path_length)";
 }
 
@@ -170,8 +162,8 @@ PublishedPathEnd finish_published_path(PullOutPath& path, const ObjectChecker& o
   out.object_id = hit.obstacle_id;
   out.clearance_m = objects.clearance(seg.points.back().pose).distance;
   out.beyond_end_pose_m = cut_k == last ? s_stop - s_end : -(s_end - s_stop);
-  std::string note = "stops " + fixed(out.clearance_m, 2) + " m before object " + std::to_string(out.object_id) + ", " +
-                     fixed(std::abs(out.beyond_end_pose_m), 1) + " m " +
+  std::string note = "stops " + format_fixed(out.clearance_m, 2) + " m before object " + std::to_string(out.object_id) +
+                     ", " + format_fixed(std::abs(out.beyond_end_pose_m), 1) + " m " +
                      (out.beyond_end_pose_m >= 0.0 ? "beyond" : "before") + " the end pose";
   if (out.beyond_end_pose_m < 0.0) note += " (closer than the planner's own checks allow)";
   if (cut_k == last && end_index < seg.points.size()) {
@@ -183,10 +175,12 @@ PublishedPathEnd finish_published_path(PullOutPath& path, const ObjectChecker& o
         pairs[cut_k].velocity_mps = std::copysign(end_speed, pairs[cut_k].velocity_mps);
       }
       note +=
-          "; too close to stop from " + fixed(planned_end_speed, 1) + " m/s within " +
-          fixed(limits.max_deceleration_mps2, 1) + " m/s^2 and " + fixed(limits.max_jerk_mps3, 1) + " m/s^3 (needs " +
-          fixed(jerk_limited_stop_distance(planned_end_speed, limits.max_deceleration_mps2, limits.max_jerk_mps3), 1) +
-          " m): the speed at the end pose is lowered to " + fixed(end_speed, 1) +
+          "; too close to stop from " + format_fixed(planned_end_speed, 1) + " m/s within " +
+          format_fixed(limits.max_deceleration_mps2, 1) + " m/s^2 and " + format_fixed(limits.max_jerk_mps3, 1) +
+          " m/s^3 (needs " +
+          format_fixed(
+              jerk_limited_stop_distance(planned_end_speed, limits.max_deceleration_mps2, limits.max_jerk_mps3), 1) +
+          " m): the speed at the end pose is lowered to " + format_fixed(end_speed, 1) +
           " m/s and comes down to 0 at the stop";
     }
   }

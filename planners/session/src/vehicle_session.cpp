@@ -55,9 +55,7 @@ PullOutPath VehicleSession::stamped(PullOutPath path) const {
   return path;
 }
 
-void VehicleSession::supersede() {
-  ++sequence_;
-  pending_ = 0;
+void VehicleSession::forget_path() {
   tracker_.clear();
   path_.reset();
   safety_.reset();
@@ -65,6 +63,12 @@ void VehicleSession::supersede() {
   last_sample_.reset();
   refused_.reset();
   refused_in_a_row_ = 0;
+}
+
+void VehicleSession::supersede() {
+  ++sequence_;
+  pending_ = 0;
+  forget_path();
 }
 
 SessionEffects VehicleSession::reject(std::uint64_t request_id, const std::vector<RequestIssue>& issues) {
@@ -178,13 +182,7 @@ SessionEffects VehicleSession::on_result(std::uint64_t sequence, const PlanningR
   status.planner_type = path.planner_type;
   status.segment_count = static_cast<std::uint32_t>(path.partial_paths.size());
 
-  tracker_.clear();
-  path_.reset();
-  safety_.reset();
-  stop_inserted_ = false;
-  last_sample_.reset();
-  refused_.reset();
-  refused_in_a_row_ = 0;
+  forget_path();
   if (status.state == ExecutionState::kWaitingApproval) {
     if (!result.world || path.partial_paths.empty() || path.partial_paths.front().points.empty()) {
       // A found path must come with the world it was planned on: without it, no safety check.
@@ -306,13 +304,7 @@ SessionEffects VehicleSession::on_time(Clock::time_point now) {
 SessionEffects VehicleSession::on_path_undeliverable(std::uint64_t request_id) {
   SessionEffects out;
   if (!path_ || status_.request_id != request_id) return out;
-  tracker_.clear();
-  path_.reset();
-  safety_.reset();
-  stop_inserted_ = false;
-  last_sample_.reset();
-  refused_.reset();
-  refused_in_a_row_ = 0;
+  forget_path();
   status_.state = ExecutionState::kNoPath;
   status_.stop_reason = "internal error: the path could not be published";
   out.status = status_;

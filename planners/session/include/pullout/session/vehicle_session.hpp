@@ -125,6 +125,8 @@ class VehicleSession {
   Clock::time_point last_input() const { return last_input_; }
 
  private:
+  // No path is followed any more: tracker, safety monitor, stop and progress reference forgotten.
+  void forget_path();
   // A request replaces whatever was followed: the running search is void, no path is followed.
   void supersede();
   SessionEffects reject(std::uint64_t request_id, const std::vector<RequestIssue>& issues);
