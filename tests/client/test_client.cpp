@@ -323,16 +323,18 @@ TEST(ClientOptionsTest, ProfilesFileNeedsTheParticipantProfile) {
 
 TEST(ClientTest, RequestReplyRoundTrip) {
   FakeService service;
-  Client client(options("car-1"));
-  ASSERT_TRUE(client.wait_for_service(10s));
-  EXPECT_EQ(client.current_request_id(), 0u);
-  EXPECT_FALSE(client.current_segment().has_value());
-
+  // State the callbacks capture is declared before the client: it must outlive the client's
+  // thread (client.hpp, "Lifetime").
   std::mutex mutex;
   std::vector<std::uint64_t> path_ids;
   std::vector<ExecutionState> states;
   std::atomic<bool> on_test_thread{false};
   const auto test_thread = std::this_thread::get_id();
+  Client client(options("car-1"));
+  ASSERT_TRUE(client.wait_for_service(10s));
+  EXPECT_EQ(client.current_request_id(), 0u);
+  EXPECT_FALSE(client.current_segment().has_value());
+
   client.on_path([&](const PullOutPath& p) {
     std::lock_guard<std::mutex> lock(mutex);
     if (std::this_thread::get_id() == test_thread) on_test_thread = true;
@@ -467,11 +469,12 @@ TEST(ClientTest, LateJoinerGetsLatestPathAndReplayedCallback) {
 
 TEST(ClientTest, UnregisteredCallbackIsNeverCalledAgain) {
   FakeService service;
-  Client client(options("car-4"));
-  ASSERT_TRUE(client.wait_for_service(10s));
   std::atomic<int> calls{0};
   std::atomic<bool> unregistered{false};
   std::atomic<int> calls_after_unregister{0};
+  std::atomic<bool> completed{false};
+  Client client(options("car-4"));
+  ASSERT_TRUE(client.wait_for_service(10s));
   client.on_status([&](const PullOutStatus&) {
     if (unregistered.load()) ++calls_after_unregister;
     std::this_thread::sleep_for(20ms);  // make a delivery in progress likely
@@ -483,7 +486,6 @@ TEST(ClientTest, UnregisteredCallbackIsNeverCalledAgain) {
   client.on_status(nullptr);
   unregistered = true;
   // A later status, delivered to a new callback: the old one would have run before it.
-  std::atomic<bool> completed{false};
   client.on_status([&](const PullOutStatus& s) {
     if (s.state == ExecutionState::kCompleted) completed = true;
   });
@@ -496,12 +498,12 @@ TEST(ClientTest, UnregisteredCallbackIsNeverCalledAgain) {
 // which uses the client (here: registers the status callback) must not deadlock.
 TEST(ClientTest, CallbackMayWaitForAnotherThreadUsingTheClient) {
   FakeService service;
-  Client client(options("car-10"));
-  ASSERT_TRUE(client.wait_for_service(10s));
   std::promise<bool> verdict;
   std::future<bool> verdict_ready = verdict.get_future();
   std::thread helper;
   std::atomic<int> status_calls{0};
+  Client client(options("car-10"));
+  ASSERT_TRUE(client.wait_for_service(10s));
   client.on_path([&](const PullOutPath&) {
     if (helper.joinable()) return;
     auto registered = std::make_shared<std::promise<void>>();
@@ -527,11 +529,11 @@ TEST(ClientTest, CallbackMayWaitForAnotherThreadUsingTheClient) {
 // on_path / on_status (which then take effect for the next delivery).
 TEST(ClientTest, CallbackMayCallTheClient) {
   FakeService service;
-  Client client(options("car-11"));
-  ASSERT_TRUE(client.wait_for_service(10s));
   std::atomic<std::uint64_t> sent{0};
   std::atomic<int> replaced_calls{0};
   std::atomic<bool> returned{false};
+  Client client(options("car-11"));
+  ASSERT_TRUE(client.wait_for_service(10s));
   client.on_path([&](const PullOutPath& p) {
     if (p.request_id != 3) return;
     sent = client.send(PullOutRequest{});
