@@ -54,10 +54,10 @@ constexpr double kFindTolerance = 0.25;    // [m] discrete end offsets, arcs tha
 constexpr double kNoPathTolerance = 0.05;  // [m] bisection of the last backward candidate, chords
 
 struct Spot {
-  bool right_hand;   // true: parking lane on the right of the eastbound road lane
-  double kerb;       // [m] from the vehicle's kerb-side edge to the kerb
-  double ahead;      // [m] free between the front bumper and the car ahead
-  double behind;     // [m] free between the rear bumper and the car behind
+  bool right_hand;  // true: parking lane on the right of the eastbound road lane
+  double kerb;      // [m] from the vehicle's kerb-side edge to the kerb
+  double ahead;     // [m] free between the front bumper and the car ahead
+  double behind;    // [m] free between the rear bumper and the car behind
 };
 
 std::ostream& operator<<(std::ostream& os, const Spot& s) {
@@ -171,7 +171,8 @@ StartPlannerParameters family_parameters() {
 // allows, less the room the first full-lock arc's outer front corner needs to clear it.
 double spare_room(const Spot& s, const VehicleInfo& v, const StartPlannerParameters& p) {
   const double m = p.lane_departure_margin;
-  const double r_min = v.wheel_base_m / std::tan(v.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale);
+  const double r_min =
+      v.wheel_base_m / std::tan(v.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale);
   // The kerb-side rear corner of the footprint expanded by m swings towards the kerb by
   // hypot(R + w, rear) - (R + w); it has `room` before the kerb-side lane edge.
   const double w_kerb = (s.right_hand ? v.base_to_right_m() : v.base_to_left_m()) + m;
@@ -294,15 +295,16 @@ TEST(GeometricSingleLaneStreet, PullsOutOfEveryParallelSpotADriverWould) {
       EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
     }
     if (spare >= kFindTolerance) {
-      const std::string name = std::string(s.right_hand ? "right-hand" : "left-hand") + " kerb " + std::to_string(s.kerb).substr(0, 3);
+      const std::string name =
+          std::string(s.right_hand ? "right-hand" : "left-hand") + " kerb " + std::to_string(s.kerb).substr(0, 3);
       auto it = std::find_if(per_family.begin(), per_family.end(), [&name](const auto& f) { return f.first == name; });
       if (it == per_family.end()) it = per_family.insert(per_family.end(), {name, {0, 0}});
       it->second[0] += found ? 1 : 0;
       ++it->second[1];
       ++counts.expected_found;
       counts.found_of_expected += found ? 1 : 0;
-      EXPECT_TRUE(found) << s << ": spare room " << spare << " m, yet no path: "
-                         << (r.path.reasons.empty() ? "" : r.path.reasons.front());
+      EXPECT_TRUE(found) << s << ": spare room " << spare
+                         << " m, yet no path: " << (r.path.reasons.empty() ? "" : r.path.reasons.front());
     } else if (spare < -kNoPathTolerance) {
       ++counts.expected_none;
       counts.none_of_expected += found ? 0 : 1;
