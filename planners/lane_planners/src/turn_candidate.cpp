@@ -42,10 +42,10 @@ ObjectChecker::Clearance refined_clearance(const PlanningContext& ctx, const Cur
   const double step = length / n;
   const double slack = 0.5 * lipschitz * step;
   ObjectChecker::Clearance best;
-  // Clearances far above the best so far cannot matter: beyond best + 2 slack they come back as
-  // +inf (cheap, from bounding circles).
+  // Clearances above the best so far plus the slack cannot matter (neither as a minimum nor to
+  // tell one): they come back as +inf, cheaply, from bounding circles.
   const auto at = [&](double s) {
-    const double h = std::min(ctx.clearance_horizon, best.distance + 2.0 * slack);
+    const double h = std::min(ctx.clearance_horizon, best.distance + slack);
     const auto c = ctx.objects.clearance(pose_along(path, s), h);
     if (c.distance < best.distance) best = c;
     return c.distance;
@@ -123,8 +123,9 @@ PathCandidate make_turn_candidate(
   }
   check_candidate(ctx, poses, {options.check_lanes, options.departure_expansion, turns_last, section_last, turns_last},
                   candidate);
-  if (!candidate.rejection || candidate.rejection->outcome == AttemptOutcome::kLaneDeparture) {
-    // The sampled clearance over the turns, made exact (see refined_clearance).
+  if (!candidate.rejection) {
+    // The sampled clearance over the turns, made exact (see refined_clearance). A rejected
+    // candidate stays rejected whatever its exact clearance.
     const double turns_section = std::min(section_end, dist.back());
     const auto refined = refined_clearance(ctx, turns.path, turns_section);
     if (refined.distance < candidate.clearance) {
