@@ -15,11 +15,28 @@ namespace {
 constexpr int kEndOffsets = 10;  // 0..9 m, as Autoware's end-pose offsets
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
+constexpr double kEdgeReach = 50.0;  // [m] outline pieces this close to the start are looked at
+
+using Edges = std::vector<std::pair<Vec2, Vec2>>;
+
+// The pieces of the lanes' outline with an end within kEdgeReach of p (along x or y): the
+// manoeuvre (two arcs and a 9 m offset) stays well inside that.
+Edges edges_near(const LaneWorld& world, const Vec2& p) {
+  Edges out;
+  const auto near = [&p](const Vec2& q) {
+    return std::abs(q.x() - p.x()) <= kEdgeReach && std::abs(q.y() - p.y()) <= kEdgeReach;
+  };
+  for (const auto& e : world.outer_edges()) {
+    if (near(e.first) || near(e.second)) out.push_back(e);
+  }
+  return out;
+}
+
 // Distance [m] from p along the unit direction `dir` to the outline of the union of the lanes
 // (the first outer edge the ray meets); +inf when it meets none.
-double distance_to_lane_edge(const LaneWorld& world, const Vec2& p, const Vec2& dir) {
+double distance_to_lane_edge(const Edges& edges, const Vec2& p, const Vec2& dir) {
   double best = kInfinity;
-  for (const auto& [a, b] : world.outer_edges()) {
+  for (const auto& [a, b] : edges) {
     // p + t dir = a + u (b - a), t >= 0, u in [0, 1].
     const Vec2 ab = b - a;
     const double den = dir.x() * ab.y() - dir.y() * ab.x();
@@ -62,10 +79,11 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
   const auto start_on_road = center.project(to_vec(start));
   const double side = start_on_road.lateral < 0.0 ? 1.0 : -1.0;  // +1: the road is to the left
   const Vec2 start_normal = left_normal(heading(start.yaw));
+  const Edges edges = edges_near(ctx.world, to_vec(start));
   const double road_side_half_width = side > 0.0 ? fp.left : fp.right;
   const double kerb_side_half_width = side > 0.0 ? fp.right : fp.left;
   // Room between the footprint and the lane edge on the kerb side, at the start.
-  const double kerb_room = distance_to_lane_edge(ctx.world, to_vec(start), -side * start_normal) - kerb_side_half_width;
+  const double kerb_room = distance_to_lane_edge(edges, to_vec(start), -side * start_normal) - kerb_side_half_width;
   // The first arc (around a centre on the road side) swings the rear corner on the kerb side
   // outwards by up to hypot(R + w, rear) - (R + w). R_min unless that crosses the kerb-side edge;
   // then the smallest radius whose swing fits: hypot(u, rear) <= u + room, u = R + w.
@@ -105,7 +123,7 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
       const Pose2 end = turns->path.end();
       const double r_second = 1.0 / std::abs(arcs[1].k0);
       const double far_room =
-          distance_to_lane_edge(ctx.world, to_vec(end), side * left_normal(heading(end.yaw))) - road_side_half_width;
+          distance_to_lane_edge(edges, to_vec(end), side * left_normal(heading(end.yaw))) - road_side_half_width;
       const double far_swing = corner_swing(r_second, fp.front, road_side_half_width, arcs[1].length / r_second);
       const double kerb_swing = corner_swing(r_first, fp.rear, kerb_side_half_width, arcs[0].length / r_first);
       if (far_swing > far_room || kerb_swing > kerb_room) {
