@@ -45,6 +45,10 @@ void BM_Plan_FullSearch(benchmark::State& state) { plan_scenario(state, "full_se
 void BM_Plan_ParallelSpot(benchmark::State& state) { plan_scenario(state, "parallel_spot"); }
 void BM_Plan_PerpendicularBay(benchmark::State& state) { plan_scenario(state, "perpendicular_bay"); }
 void BM_Plan_CarCloseAhead(benchmark::State& state) { plan_scenario(state, "car_close_ahead"); }
+// One road lane, no opposite lane: geometric from the spot (shift fails first at every margin).
+void BM_Plan_SingleLaneStreet(benchmark::State& state) { plan_scenario(state, "single_lane_street"); }
+// The same in left-hand traffic, 0.3 m from the kerb: reverse to just clear of the car behind first.
+void BM_Plan_SingleLaneStreetLeftHand(benchmark::State& state) { plan_scenario(state, "single_lane_street_left_hand"); }
 // The freespace fallback, whole pipeline: the lane-based search fails, then the costmap is built
 // from the lanes and objects, end poses are searched on the lane ahead, and hybrid A* runs.
 void BM_Plan_FreespaceBoxedIn(benchmark::State& state) { plan_scenario(state, "freespace_boxed_in"); }
@@ -65,6 +69,8 @@ BENCHMARK(BM_Plan_FullSearch)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_ParallelSpot)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_PerpendicularBay)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_CarCloseAhead)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_SingleLaneStreet)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Plan_SingleLaneStreetLeftHand)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_FreespaceBoxedIn)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_FreespacePerpendicularBay)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Plan_FreespaceTinyDeadline)->Unit(benchmark::kMicrosecond);

@@ -40,13 +40,13 @@ std::ostream& operator<<(std::ostream& os, const PropertyCase& c) {
 
 const PropertyCase kCases[] = {
     {"straight_shoulder", PlannerType::kShift, true},
-    {"straight_shoulder", PlannerType::kGeometric, false},
+    {"straight_shoulder", PlannerType::kGeometric, true},
     {"straight_shoulder", PlannerType::kClothoid, true},
     {"curved_road", PlannerType::kShift, true},
-    {"curved_road", PlannerType::kGeometric, false},
+    {"curved_road", PlannerType::kGeometric, true},
     {"curved_road", PlannerType::kClothoid, true},
     {"parked_car_ahead", PlannerType::kShift, true},
-    {"parked_car_ahead", PlannerType::kGeometric, false},
+    {"parked_car_ahead", PlannerType::kGeometric, true},
     {"parked_car_ahead", PlannerType::kClothoid, true},
     {"boxed_in", PlannerType::kShift, false},
     {"boxed_in", PlannerType::kGeometric, false},
@@ -61,12 +61,16 @@ const PropertyCase kCases[] = {
     {"parallel_spot_reverse", PlannerType::kGeometric, true},
     {"parallel_spot_reverse", PlannerType::kClothoid, true},
     {"car_close_ahead", PlannerType::kShift, true},
-    {"car_close_ahead", PlannerType::kGeometric, false},
+    {"car_close_ahead", PlannerType::kGeometric, true},
     {"car_close_ahead", PlannerType::kClothoid, true},
     {"full_search", PlannerType::kShift, false},
     {"full_search", PlannerType::kGeometric, false},
     {"full_search", PlannerType::kClothoid, false},
     {"clothoid_only", PlannerType::kClothoid, true},
+    {"single_lane_street", PlannerType::kShift, false},
+    {"single_lane_street", PlannerType::kGeometric, true},
+    {"single_lane_street_left_hand", PlannerType::kShift, false},
+    {"single_lane_street_left_hand", PlannerType::kGeometric, true},
     {"freespace_boxed_in", PlannerType::kFreespace, true},
     {"freespace_perpendicular_bay", PlannerType::kFreespace, true},
     {"freespace_parking_lot", PlannerType::kFreespace, true},
@@ -345,10 +349,19 @@ TEST_P(ScenarioExpectations, MatchTheFile) {
 }
 
 // The map scenarios too (their path properties are checked in test_map_planning.cpp).
-const char* const kExpectationScenarios[] = {
-    "straight_shoulder", "curved_road",       "parked_car_ahead",      "boxed_in",
-    "parallel_spot",     "perpendicular_bay", "parallel_spot_reverse", "car_close_ahead",
-    "full_search",       "map_shoulder",      "clothoid_only"};
+const char* const kExpectationScenarios[] = {"straight_shoulder",
+                                             "curved_road",
+                                             "parked_car_ahead",
+                                             "boxed_in",
+                                             "parallel_spot",
+                                             "perpendicular_bay",
+                                             "parallel_spot_reverse",
+                                             "car_close_ahead",
+                                             "full_search",
+                                             "map_shoulder",
+                                             "clothoid_only",
+                                             "single_lane_street",
+                                             "single_lane_street_left_hand"};
 INSTANTIATE_TEST_SUITE_P(Bundled, ScenarioExpectations, ::testing::ValuesIn(kExpectationScenarios));
 
 TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {

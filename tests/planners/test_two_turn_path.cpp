@@ -72,6 +72,40 @@ TEST(TwoTurnPath, ArcSCurveMatchesTheWorkedExample) {
   EXPECT_NEAR(t->path.end().yaw, 0.0, 1e-9);
 }
 
+TEST(ArcPair, ReachesTheEndPoseWithTheRadiiOfTheWorkedFormula) {
+  // Parallel start d below the centerline, end L ahead on it: the S of two tangent arcs turns by
+  // the same angle t both ways, (R1 + R2)(1 - cos t) = d and (R1 + R2) sin t = L, so
+  // R1 + R2 = (L^2 + d^2) / (2 d).
+  const double d = 3.5;
+  const double r1 = 5.06;
+  for (double length : {7.65, 9.0, 12.0, 16.65}) {
+    const auto t = solve_arc_pair({0.0, -d, 0.0}, {length, 0.0, 0.0}, r1, r1 * 0.99);
+    ASSERT_TRUE(t.has_value()) << length;
+    ASSERT_EQ(t->path.pieces().size(), 2u);
+    EXPECT_EQ(t->first_turn_pieces, 1u);
+    const auto& arcs = t->path.pieces();
+    EXPECT_NEAR(1.0 / arcs[0].k0, r1, 1e-12);  // turns left first, at R1
+    const double r2 = -1.0 / arcs[1].k0;       // then right
+    EXPECT_NEAR(r1 + r2, (length * length + d * d) / (2.0 * d), 1e-9) << length;
+    const double turn = std::asin(length / (r1 + r2));
+    EXPECT_NEAR(arcs[0].length, r1 * turn, 1e-9);
+    EXPECT_NEAR(arcs[1].length, r2 * turn, 1e-9);
+    EXPECT_NEAR(t->path.end().x, length, 1e-9);
+    EXPECT_NEAR(t->path.end().y, 0.0, 1e-9);
+    EXPECT_NEAR(t->path.end().yaw, 0.0, 1e-9);
+  }
+  // Mirrored: start above the centerline turns right first.
+  const auto m = solve_arc_pair({0.0, d, 0.0}, {12.0, 0.0, 0.0}, r1, r1);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_LT(m->path.pieces()[0].k0, 0.0);
+  // An end closer than two arcs of R1 allow needs R2 < R1: refused below the minimum radius.
+  EXPECT_FALSE(solve_arc_pair({0.0, -d, 0.0}, {6.0, 0.0, 0.0}, r1, r1).has_value());
+  // Facing across the road, farther than R1 from the centerline (out of a perpendicular bay):
+  // the first arc's circle and any second one tangent to the centerline at the end cannot touch
+  // (|C1 - C2|^2 = (R1 + R2)^2 needs (R1 - 8)^2 + (6 + R2)^2 = (R1 + R2)^2, i.e. R2 < 0).
+  EXPECT_FALSE(solve_arc_pair({0.0, 6.0, -kPi / 2}, {8.0, 0.0, 0.0}, r1, r1).has_value());
+}
+
 TEST(TwoTurnPath, ClothoidTurnsStayWithinTheirPeakCurvature) {
   const VehicleInfo v;
   for (double steer_deg : {5.0, 10.0, 20.0, 30.0}) {

@@ -2,33 +2,138 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
+#include "pullout/collision/footprint.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/lane_planners/two_turn_path.hpp"
 #include "turn_candidate.hpp"
 
 namespace pullout {
 
 namespace {
-constexpr int kTangentLengths = 10;  // 0..9 m, as Autoware's end-pose offsets
+constexpr int kEndOffsets = 10;  // 0..9 m, as Autoware's end-pose offsets
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+constexpr double kEdgeReach = 50.0;  // [m] outline pieces this close to the start are looked at
+
+using Edges = std::vector<std::pair<Vec2, Vec2>>;
+
+// The pieces of the lanes' outline with an end within kEdgeReach of p (along x or y): the
+// manoeuvre (two arcs and a 9 m offset) stays well inside that.
+Edges edges_near(const LaneWorld& world, const Vec2& p) {
+  Edges out;
+  const auto near = [&p](const Vec2& q) {
+    return std::abs(q.x() - p.x()) <= kEdgeReach && std::abs(q.y() - p.y()) <= kEdgeReach;
+  };
+  for (const auto& e : world.outer_edges()) {
+    if (near(e.first) || near(e.second)) out.push_back(e);
+  }
+  return out;
 }
+
+// Distance [m] from p along the unit direction `dir` to the outline of the union of the lanes
+// (the first outer edge the ray meets); +inf when it meets none.
+double distance_to_lane_edge(const Edges& edges, const Vec2& p, const Vec2& dir) {
+  double best = kInfinity;
+  for (const auto& [a, b] : edges) {
+    // p + t dir = a + u (b - a), t >= 0, u in [0, 1].
+    const Vec2 ab = b - a;
+    const double den = dir.x() * ab.y() - dir.y() * ab.x();
+    if (std::abs(den) < 1e-12) continue;
+    const Vec2 ap = a - p;
+    const double t = (ap.x() * ab.y() - ap.y() * ab.x()) / den;
+    const double u = (ap.x() * dir.y() - ap.y() * dir.x()) / den;
+    if (t >= 0.0 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
+  }
+  return best;
+}
+
+// How far [m] a footprint corner at (along, across) from base_link - `along` ahead (> 0) or behind,
+// `across` > 0 outwards on the side away from the arc's centre - gets beyond the line where that
+// side of the footprint was at the arc's start, while the vehicle turns by `turn` [rad] on an arc
+// of radius r: the corner circles the centre at hypot(r + across, along), and its excursion
+// peaks once the vehicle has turned by atan(along / (r + across)).
+double corner_swing(double r, double along, double across, double turn) {
+  const double u = r + across;
+  const double radius = std::hypot(u, along);
+  const double peak = std::atan2(along, u);
+  return (turn >= peak ? radius : radius * std::cos(peak - turn)) - u;
+}
+
+}  // namespace
 
 PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2& start,
                                          const StopCondition& stop) const {
   const auto& p = ctx.parameters;
   PlannerCandidates out;
   const double steer = ctx.vehicle.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale;
-  const double kappa = std::tan(steer) / ctx.vehicle.wheel_base_m;
+  const double r_min = ctx.vehicle.wheel_base_m / std::tan(steer);
+  const double kappa = 1.0 / r_min;
   const Polyline window = turn_window(ctx, start);
   const double v = p.geometric_pull_out_velocity;
-  for (int k = 0; k < kTangentLengths; ++k) {
+
+  // The footprint as the lane check sees it (expanded by lane_departure_margin).
+  const Footprint fp = vehicle_footprint(ctx.vehicle, p.lane_departure_margin);
+  const Polyline& center = ctx.road.centerline;
+  const auto start_on_road = center.project(to_vec(start));
+  const double side = start_on_road.lateral < 0.0 ? 1.0 : -1.0;  // +1: the road is to the left
+  const Vec2 start_normal = left_normal(heading(start.yaw));
+  const Edges edges = edges_near(ctx.world, to_vec(start));
+  const double road_side_half_width = side > 0.0 ? fp.left : fp.right;
+  const double kerb_side_half_width = side > 0.0 ? fp.right : fp.left;
+  // Room between the footprint and the lane edge on the kerb side, at the start.
+  const double kerb_room = distance_to_lane_edge(edges, to_vec(start), -side * start_normal) - kerb_side_half_width;
+  // The first arc (around a centre on the road side) swings the rear corner on the kerb side
+  // outwards by up to hypot(R + w, rear) - (R + w). R_min unless that crosses the kerb-side edge;
+  // then the smallest radius whose swing fits: hypot(u, rear) <= u + room, u = R + w.
+  double r_first = r_min;
+  if (kerb_room > 0.0 && std::isfinite(kerb_room) &&
+      corner_swing(r_min, fp.rear, kerb_side_half_width, kPi) > kerb_room) {
+    r_first = std::max(r_min, (fp.rear * fp.rear - kerb_room * kerb_room) / (2.0 * kerb_room) - kerb_side_half_width);
+  }
+  // The base end pose: where two arcs of r_first end on the centerline from a parallel start
+  // (Autoware's), 2 sqrt(R^2 - (R - d/2)^2) ahead; candidates move it 0..9 m further.
+  const double half_offset = 0.5 * std::abs(start_on_road.lateral);
+  const double q = r_first * r_first - (r_first - half_offset) * (r_first - half_offset);
+  const double s_base = start_on_road.s + 2.0 * std::sqrt(std::max(q, 0.0));
+
+  for (int k = 0; k < kEndOffsets; ++k) {
     out.stopped = stop.check();
     if (out.stopped != StopReason::kNone) break;
-    const auto turns = solve_two_turn(start, window, {kappa, 0.0, static_cast<double>(k)});
+    // An S of two arcs to the end pose on the centerline: the first arc at r_first, the second's
+    // radius solved (Vorobieva). Where no S reaches it (a start across the road, out of a
+    // perpendicular bay), two turns at R_min joined by a k m tangent.
+    std::optional<TwoTurnPath> turns;
+    const double s_end = s_base + k;
+    if (q >= 0.0 && s_end <= center.length()) turns = solve_arc_pair(start, center.pose_at(s_end), r_first, r_min);
+    const bool arc_pair = turns.has_value();
+    if (!arc_pair) turns = solve_two_turn(start, window, {kappa, 0.0, static_cast<double>(k)});
     if (!turns) {
       PathCandidate none;
       none.rejection = Failure{AttemptOutcome::kNoGeometry, "no two-arc path to the centerline"};
       out.candidates.push_back(std::move(none));
       continue;
+    }
+    if (arc_pair) {
+      // The swing of the outermost corners, analytically, before the footprint check: the front
+      // corner on the road side on the second arc against the lane edge beyond the end pose, the
+      // rear corner on the kerb side on the first arc against the kerb-side edge.
+      const auto& arcs = turns->path.pieces();
+      const Pose2 end = turns->path.end();
+      const double r_second = 1.0 / std::abs(arcs[1].k0);
+      const double far_room =
+          distance_to_lane_edge(edges, to_vec(end), side * left_normal(heading(end.yaw))) - road_side_half_width;
+      const double far_swing = corner_swing(r_second, fp.front, road_side_half_width, arcs[1].length / r_second);
+      const double kerb_swing = corner_swing(r_first, fp.rear, kerb_side_half_width, arcs[0].length / r_first);
+      if (far_swing > far_room || kerb_swing > kerb_room) {
+        PathCandidate swing;
+        swing.rejection = Failure{AttemptOutcome::kLaneDeparture,
+                                  far_swing > far_room ? "the front corner swings over the far lane edge"
+                                                       : "the rear corner swings over the kerb-side edge"};
+        out.candidates.push_back(std::move(swing));
+        continue;
+      }
     }
     // The stop to re-steer is needed where the steering swaps sides (an S-shaped path); two turns
     // the same way (out of a perpendicular bay) flow into each other.

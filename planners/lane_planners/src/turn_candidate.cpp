@@ -14,6 +14,81 @@ constexpr double kWindowBehind = 5.0;  // [m] centerline window around the start
 constexpr double kWindowAhead = 35.0;  // two turns and a 9 m tangent end within about 25 m
 constexpr double kWindowStep = 1.0;
 
+constexpr int kGoldenIterations = 10;  // a bracket of 2 kCheckInterval shrinks to about 8 mm
+
+// Pose at distance s along the path (clamped).
+Pose2 pose_along(const CurvaturePath& path, double s) {
+  Pose2 p = path.start();
+  for (const CurvaturePiece& piece : path.pieces()) {
+    if (s <= piece.length) return CurvaturePath::advance(p, piece, std::max(s, 0.0));
+    s -= piece.length;
+    p = CurvaturePath::advance(p, piece, piece.length);
+  }
+  return p;
+}
+
+// The smallest clearance to the obstacles over the path's first `length` metres. Samples every
+// kCheckInterval can miss the closest approach of a corner passing an obstacle's corner by
+// centimetres. The clearance is Lipschitz in the distance driven, with constant
+// L = 1 + max|curvature| * (the footprint's bounding radius) (the fastest point of the
+// footprint), so the true minimum lies within one interval of a sample whose clearance is less
+// than L * interval / 2 above the smallest sampled one, and that is a local minimum of the
+// samples; around each such sample the closest approach (one per obstacle passed: the distance is
+// unimodal there) is found by golden-section search. Skipped when even the lowest possible value
+// stays above the context's clearance_horizon.
+ObjectChecker::Clearance refined_clearance(const PlanningContext& ctx, const CurvaturePath& path, double length) {
+  const double lipschitz = 1.0 + path.max_abs_curvature() * ctx.objects.footprint().bounding_radius();
+  const int n = std::max(1, static_cast<int>(std::ceil(length / kCheckInterval)));
+  const double step = length / n;
+  const double slack = 0.5 * lipschitz * step;
+  ObjectChecker::Clearance best;
+  // Clearances above the best so far plus the slack cannot matter (neither as a minimum nor to
+  // tell one): they come back as +inf, cheaply, from bounding circles.
+  const auto at = [&](double s) {
+    const double h = std::min(ctx.clearance_horizon, best.distance + slack);
+    const auto c = ctx.objects.clearance(pose_along(path, s), h);
+    if (c.distance < best.distance) best = c;
+    return c.distance;
+  };
+  std::vector<double> sampled(static_cast<std::size_t>(n) + 1);
+  for (int i = 0; i <= n; ++i) {
+    sampled[i] = at(step * i);
+    if (best.distance <= 0.0) return best;
+  }
+  const double sampled_best = best.distance;
+  // Nothing within reach of the largest margin: the exact value does not matter.
+  if (!(sampled_best - slack < ctx.clearance_horizon)) return best;
+  constexpr double kGolden = 0.6180339887498949;
+  for (int i = 0; i <= n; ++i) {
+    // A closest approach between samples makes one of its two neighbours a local minimum of the
+    // samples; the bracket covers both intervals beside it.
+    const bool local_min = (i == 0 || sampled[i] <= sampled[i - 1]) && (i == n || sampled[i] <= sampled[i + 1]);
+    if (!local_min || !(sampled[i] < sampled_best + slack)) continue;
+    double a = std::max(0.0, step * (i - 1));
+    double b = std::min(length, step * (i + 1));
+    double x1 = b - kGolden * (b - a);
+    double x2 = a + kGolden * (b - a);
+    double f1 = at(x1);
+    double f2 = at(x2);
+    for (int k = 0; k < kGoldenIterations && best.distance > 0.0; ++k) {
+      if (f1 < f2) {
+        b = x2;
+        x2 = x1;
+        f2 = f1;
+        x1 = b - kGolden * (b - a);
+        f1 = at(x1);
+      } else {
+        a = x1;
+        x1 = x2;
+        f1 = f2;
+        x2 = a + kGolden * (b - a);
+        f2 = at(x2);
+      }
+    }
+  }
+  return best;
+}
+
 std::vector<double> cumulative_distance(const std::vector<Pose2>& poses) {
   std::vector<double> d(poses.size(), 0.0);
   for (std::size_t i = 1; i < poses.size(); ++i) {
@@ -48,6 +123,19 @@ PathCandidate make_turn_candidate(
   }
   check_candidate(ctx, poses, {options.check_lanes, options.departure_expansion, turns_last, section_last, turns_last},
                   candidate);
+  if (!candidate.rejection) {
+    // The sampled clearance over the turns, made exact (see refined_clearance). A rejected
+    // candidate stays rejected whatever its exact clearance.
+    const double turns_section = std::min(section_end, dist.back());
+    const auto refined = refined_clearance(ctx, turns.path, turns_section);
+    if (refined.distance < candidate.clearance) {
+      candidate.clearance = refined.distance;
+      candidate.nearest_obstacle = refined.obstacle_id;
+    }
+    if (candidate.clearance < 1e-6) {  // contact, as check_candidate counts it
+      candidate.rejection = Failure{AttemptOutcome::kCollision, "object " + std::to_string(candidate.nearest_obstacle)};
+    }
+  }
 
   auto shared_turns = std::make_shared<const TwoTurnPath>(turns);
   const double interval = options.output_interval;

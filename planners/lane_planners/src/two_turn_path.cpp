@@ -81,7 +81,53 @@ std::optional<double> refine(const F& f, double a, double fa, double b, double f
   return std::nullopt;
 }
 
+// Turning angle in (0, 2 pi) from radius vector a to b going round in direction `side` (+1:
+// counter-clockwise).
+double turning_angle(const Vec2& a, const Vec2& b, double side) {
+  double w = side * std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  if (w <= 0.0) w += kTwoPi;
+  return w;
+}
+
 }  // namespace
+
+std::optional<TwoTurnPath> solve_arc_pair(const Pose2& start, const Pose2& end, double r1, double min_radius) {
+  constexpr double kMinLateral = 1e-3;    // [m] an end closer to the start's line needs no S
+  constexpr double kMinTurn = 1e-6;       // [rad]
+  constexpr double kEndTolerance = 1e-6;  // [m] the constructed path must end on `end`
+  if (r1 <= 0.0) return std::nullopt;
+  const Vec2 s = to_vec(start);
+  const Vec2 e = to_vec(end);
+  const Vec2 n_start = left_normal(heading(start.yaw));
+  const double lateral = (e - s).dot(n_start);
+  if (std::abs(lateral) < kMinLateral) return std::nullopt;
+  const double side = lateral > 0.0 ? 1.0 : -1.0;  // +1: the first arc turns left
+  const Vec2 c1 = s + side * r1 * n_start;
+  const Vec2 n = -side * left_normal(heading(end.yaw));  // from the end towards the second centre
+  const Vec2 d = c1 - e;
+  const double denom = 2.0 * (r1 + d.dot(n));
+  if (denom <= 1e-12) return std::nullopt;
+  const double r2 = (d.squaredNorm() - r1 * r1) / denom;
+  if (r2 <= 0.0 || r2 < min_radius * (1.0 - 1e-9)) return std::nullopt;
+  const Vec2 c2 = e + r2 * n;
+  const Vec2 c12 = c2 - c1;
+  if (c12.norm() < 1e-12) return std::nullopt;
+  const Vec2 t = c1 + r1 * c12.normalized();  // where the arcs touch
+  const double w1 = turning_angle(s - c1, t - c1, side);
+  const double w2 = turning_angle(t - c2, e - c2, -side);
+  // Forward S only: each arc turns by less than half a circle (a full angle means no turn).
+  if (w1 >= kPi || w2 >= kPi || w1 < kMinTurn || w2 < kMinTurn) return std::nullopt;
+  TwoTurnPath out;
+  out.path = CurvaturePath(start, {{r1 * w1, side / r1, side / r1}, {r2 * w2, -side / r2, -side / r2}});
+  out.first_turn_pieces = 1;
+  const Pose2 reached = out.path.end();
+  out.lateral_error = (to_vec(reached) - e).dot(left_normal(heading(end.yaw)));
+  out.heading_error = normalize_angle(reached.yaw - end.yaw);
+  if ((to_vec(reached) - e).norm() > kEndTolerance || std::abs(out.heading_error) > kEndTolerance) {
+    return std::nullopt;
+  }
+  return out;
+}
 
 std::optional<TwoTurnPath> solve_two_turn(const Pose2& start, const Polyline& center, const TwoTurnSpec& spec) {
   if (center.size() < 2 || spec.kappa <= 0.0) return std::nullopt;

@@ -10,6 +10,9 @@ namespace pullout {
 
 namespace {
 
+constexpr double kMinCandidateSpacing = 0.05;  // [m] a last, shortened step shorter than this is not taken
+constexpr double kBisectionTolerance = 1e-3;   // [m] of the pose just clear of the obstacle behind
+
 // Where the vehicle stands on the pull-out lanes, and which way it faces along them: +1 with the
 // lanes' direction, -1 against it (a vehicle parked nose-in in a bay drawn towards the road).
 struct LanePosition {
@@ -50,15 +53,14 @@ StartCandidateSearch search_start_candidates(const PlanningContext& ctx, const S
   // The current pose is always candidate 0, whatever is ahead (Autoware MAIN also puts the ego
   // pose first); the checks below pick the poses worth reversing to.
   out.candidates.push_back({ego, 0.0});
-  for (double back = p.backward_search_resolution; back <= allowed + 1e-9; back += p.backward_search_resolution) {
+  const std::string what = "start candidate";
+  // Whether a pose `back` behind keeps the smallest margin to every obstacle.
+  const auto clear_at = [&](double back) {
+    return ctx.objects.clearance(backed_pose(lanes, at, back), last_margin).distance >= last_margin;
+  };
+  // Adds the candidate `back` behind unless an object ahead or the lanes' end rule it out.
+  const auto consider = [&](double back) {
     const Pose2 pose = backed_pose(lanes, at, back);
-    const std::string what = "start candidate";
-    const auto hit = ctx.objects.clearance(pose, last_margin);
-    if (hit.distance < last_margin) {
-      out.skipped.push_back({back, what + " within " + format_fixed(last_margin, 2) + " m of object " +
-                                       std::to_string(hit.obstacle_id) + ": backward search ends"});
-      break;
-    }
     const auto front = ctx.objects.clearance_ahead(pose, p.collision_check_margin_from_front_object);
     // 1 um below the margin: a candidate exactly at it (up to rounding) counts as clear.
     if (front.distance < p.collision_check_margin_from_front_object - 1e-6) {
@@ -66,15 +68,39 @@ StartCandidateSearch search_start_candidates(const PlanningContext& ctx, const S
                                        std::to_string(front.obstacle_id) +
                                        " ahead (collision_check_margin_from_front_object " +
                                        format_fixed(p.collision_check_margin_from_front_object, 1) + " m)"});
-      continue;
+      return;
     }
     const double s_back = at.s - at.facing * back;
     const double to_end = at.facing > 0.0 ? lanes.centerline.length() - s_back : s_back;
     if (to_end < p.ignore_distance_from_lane_end) {
       out.skipped.push_back({back, what + " skipped: closer than ignore_distance_from_lane_end to the lanes' end"});
-      continue;
+      return;
     }
     out.candidates.push_back({pose, back});
+  };
+  // Steps of backward_search_resolution, the last one shortened to end where the room behind
+  // ends (the lanes, max_back_distance, or the first obstacle within the smallest margin).
+  double previous = 0.0;
+  while (previous < allowed - kMinCandidateSpacing) {
+    const double back = std::min(previous + p.backward_search_resolution, allowed);
+    if (clear_at(back)) {
+      consider(back);
+      previous = back;
+      continue;
+    }
+    // Blocked within this step: the pose just clear of the obstacle (bisection; clearance falls
+    // as the vehicle backs towards it) is the last candidate.
+    double lo = previous;
+    double hi = back;
+    while (hi - lo > kBisectionTolerance) {
+      const double mid = 0.5 * (lo + hi);
+      (clear_at(mid) ? lo : hi) = mid;
+    }
+    if (lo > previous + kMinCandidateSpacing) consider(lo);
+    const auto hit = ctx.objects.clearance(backed_pose(lanes, at, back), last_margin);
+    out.skipped.push_back({back, what + " within " + format_fixed(last_margin, 2) + " m of object " +
+                                     std::to_string(hit.obstacle_id) + ": backward search ends"});
+    break;
   }
   return out;
 }

@@ -23,13 +23,15 @@ struct StartCandidateSearch {
   std::vector<Skipped> skipped;  // candidates skipped, and the one that ended the search
 };
 
-// Candidate 0 is the current pose itself, always. With enable_back, then: poses every
-// backward_search_resolution behind the vehicle on the line through it parallel to the pull-out
-// lanes' centerline, up to max_back_distance (and no further than keeps the rear inside the
-// pull-out lanes). A backward candidate within collision_check_margin_from_front_object of a
-// static obstacle ahead of it, or closer than ignore_distance_from_lane_end to the lanes' end, is
-// skipped; the first one within the smallest collision margin of any obstacle ends the search
-// (the vehicle cannot reverse through it).
+// Candidate 0 is the current pose itself, always. With enable_back, then: poses behind the
+// vehicle on the line through it parallel to the pull-out lanes' centerline, every
+// backward_search_resolution, as far as the room behind allows: up to max_back_distance, no
+// further than keeps the rear inside the pull-out lanes, and short of the first obstacle within
+// the smallest collision margin. Where the room ends between two steps, the last step is
+// shortened to end there (to the pose just clear of the obstacle, within 1 mm, or exactly at the
+// lanes' limit), unless it would be shorter than 5 cm. A backward candidate within
+// collision_check_margin_from_front_object of a static obstacle ahead of it, or closer than
+// ignore_distance_from_lane_end to the lanes' end, is skipped.
 StartCandidateSearch search_start_candidates(const PlanningContext& context, const StartPlannerParameters& parameters,
                                              const Pose2& ego);
 

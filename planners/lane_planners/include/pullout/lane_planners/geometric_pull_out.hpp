@@ -1,11 +1,28 @@
-// Geometric pull-out: two circular arcs at the vehicle's tightest usable radius, joined by a common
-// tangent of 0..9 m (the reverse of a parallel-parking manoeuvre; Vorobieva et al., IFAC 2013).
+// Geometric pull-out: two circular arcs turning opposite ways (an S), the reverse of a
+// parallel-parking manoeuvre (Vorobieva et al., IFAC 2013), as Autoware's.
 //
-// Radius R = wheel_base / tan(max_steer_angle * geometric_pull_out_max_steer_angle_margin_scale).
-// Candidates, tightest first: tangent lengths 0, 1, ..., 9 m (Autoware moves the end pose by the
-// same offsets and recomputes one radius; a common tangent keeps both arcs at R and so the
-// curvature within 1/R everywhere). Lane departure: the footprint, expanded by
-// lane_departure_margin, must stay inside the lanes over the arcs, checked every 0.5 m.
+// R_min = wheel_base / tan(max_steer_angle * geometric_pull_out_max_steer_angle_margin_scale).
+// The first arc (out of the spot) has radius R1 = R_min; the end pose lies on the road
+// centerline, 2 sqrt(R1^2 - (R1 - d/2)^2) ahead of the start (d: the start's lateral offset from
+// the centerline; where two arcs of R1 would end) plus an offset of 0, 1, ..., 9 m (the
+// candidates, tightest first), and the second arc's radius is solved so that the S ends exactly
+// there (solve_arc_pair): R2 = R1 at offset 0 and grows with it. A larger R2 swings the front
+// corner on the road side less far beyond the end pose (by hypot(R2 + w, front) - (R2 + w)),
+// which is what lets the vehicle pull out onto a single road lane with no opposite lane to swing
+// into.
+//
+// Before the footprint check, the swing of the outermost corners is checked analytically (exact
+// on a straight road): the front corner on the road side over the second arc against the lane
+// edge beyond the end pose, and the rear corner on the kerb side over the first arc against the
+// kerb-side lane edge; a candidate that fails is rejected as lane departure. Unlike Autoware, when
+// the rear corner's swing at R_min would cross the kerb-side edge (a car parked close to the
+// kerb), R1 is raised to the smallest radius whose swing fits, rather than giving up. Where no S
+// reaches the end pose (a start across the road: out of a perpendicular bay), the candidate is
+// two turns at R_min joined by a common tangent of the offset's length (the same way or opposite
+// ways, solve_two_turn).
+//
+// Lane departure: the footprint, expanded by lane_departure_margin, must stay inside the lanes
+// (in the analytic check and in the footprint check over the arcs, every 0.5 m).
 //
 // divide_pull_out_path = true: two partial paths, split at the end of the first arc where the
 // vehicle stops to re-steer, when the arcs turn opposite ways (an S); false, or two arcs turning

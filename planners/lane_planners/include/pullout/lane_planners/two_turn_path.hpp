@@ -36,4 +36,14 @@ struct TwoTurnPath {
 // these turns, or the turns cannot reach it going forward).
 std::optional<TwoTurnPath> solve_two_turn(const Pose2& start, const Polyline& centerline, const TwoTurnSpec& spec);
 
+// Two circular arcs turning opposite ways (an S) from `start` exactly to `end` (position and
+// heading), as in Vorobieva et al. (IFAC 2013): the first arc has radius `first_radius` [m] and
+// turns towards the side `end` lies on; the second arc's radius is solved so that the arcs are
+// tangent where they meet. With C1 the first centre (first_radius beside `start`), n the unit
+// normal at `end` towards the second centre and D = C1 - end:
+//   R2 = (|D|^2 - R1^2) / (2 (R1 + D . n)).
+// nullopt when the end is straight ahead of or behind the start, when no such S moving forward
+// exists (an arc would turn by pi or more, or R2 <= 0), or when R2 < `min_radius` [m].
+std::optional<TwoTurnPath> solve_arc_pair(const Pose2& start, const Pose2& end, double first_radius, double min_radius);
+
 }  // namespace pullout
