@@ -8,6 +8,8 @@
 //                 sequential straight_shoulder requests; latency = send() -> wait_for_path()
 //                 returning. The service's own planning time (status.planning_time_ms) is
 //                 collected too.
+//   2b. secure    the same with DDS Security (a test PKI made for the run by
+//                 scripts/make-test-pki; config/dds/security/governance.xml).
 //   3. ping-pong  a second process (this binary with --echo) echoes samples over two topics
 //                 (bench/ping, bench/pong) with the QoS of pullout/path (reliable, transient
 //                 local, keep last 1). Two series: the real reply (a PullOutPath of the same
@@ -29,6 +31,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <exception>
 #include <optional>
@@ -246,10 +249,13 @@ struct E2eResult {
   std::size_t lost{0};
 };
 
-E2eResult measure_e2e(const pullout::Scenario& scenario, int domain, int warmup, int requests) {
+// `security_dir`: the vehicle's DDS Security credentials (empty: none).
+E2eResult measure_e2e(const pullout::Scenario& scenario, int domain, int warmup, int requests,
+                      const std::string& security_dir = "") {
   pullout::ClientOptions options;
   options.vehicle_id = "bench-e2e";
   options.domain_id = domain;  // built-in loopback-only defaults
+  options.security_dir = security_dir;
   pullout::Client client(options);
   if (!client.wait_for_service(kMatchTimeout)) throw std::runtime_error("the client did not match the service");
   E2eResult r;
@@ -375,6 +381,29 @@ int run_bench(int requests, int warmup, int pings, int plans) {
   }
   if (e2e.latency_ms.empty()) throw std::runtime_error("no request was answered");
 
+  // 2b. The same with DDS Security (test PKI of scripts/make-test-pki, config/dds/security/:
+  // authentication, access control, payloads and submessages encrypted).
+  E2eResult secure;
+  integration::StopReport secure_report;
+  {
+    integration::TempDir dir;
+    const std::string pki = dir.path() + "/pki";
+    const std::string command =
+        "bash '" + source_path("scripts/make-test-pki") + "' '" + pki + "' bench-e2e >/dev/null";
+    if (std::system(command.c_str()) != 0) throw std::runtime_error("scripts/make-test-pki failed");
+    integration::ServiceOptions options;
+    options.executable = service_exe;
+    options.config_path = dir.write_file("secure.yaml", "dds:\n  profiles_file: " +
+                                                            source_path("config/dds/loopback.xml") +
+                                                            "\n  security_dir: " + pki + "/service\n");
+    options.domain = lease.domain();
+    options.probe_security_dir = pki + "/vehicles/bench-e2e";
+    options.probe_vehicle_id = "bench-e2e";
+    integration::ServiceProcess service(options);
+    secure = measure_e2e(scenario, lease.domain(), warmup, requests, pki + "/vehicles/bench-e2e");
+    secure_report = service.stop();
+  }
+
   // 3. The DDS floor, with the service stopped.
   const pullout::msg::PullOutPath reply_msg = pullout::idl::to_msg(e2e.reply);
   pullout::PullOutRequest sent = scenario.request;
@@ -418,6 +447,7 @@ int run_bench(int requests, int warmup, int pings, int plans) {
               reply_bytes, reply_points, e2e.reply.partial_paths.size());
   std::printf("| measurement [ms] | n | p50 | p90 | p99 | max |\n|---|---|---|---|---|---|\n");
   print_row("e2e: send() -> path received (service process, pullout::Client)", e2e_s);
+  print_row("e2e with DDS Security (authenticated, encrypted)", summarize(secure.latency_ms));
   print_row("service planning time (status.planning_time_ms)", svc_s);
   print_row("in-process StartPlanner::plan", plan_s);
   print_row("DDS round trip, reply-sized both ways", sym_s);
@@ -430,10 +460,13 @@ int run_bench(int requests, int warmup, int pings, int plans) {
       e2e_s.p50, floor, plan_s.p50, asym_s.p50, e2e_s.p50 - floor);
   std::printf("with the reply-sized round trip both ways: floor %.3f ms, overhead %.3f ms\n", plan_s.p50 + sym_s.p50,
               e2e_s.p50 - plan_s.p50 - sym_s.p50);
-  std::printf("lost: e2e %zu, ping-pong %zu; service %s, %zu file(s) left in /dev/shm; echo %s\n", e2e.lost, ping.lost,
-              service_report.exit.describe().c_str(), service_report.leaked_shm_files.size(),
-              echo_exit.describe().c_str());
-  const bool clean = e2e.lost == 0 && ping.lost == 0 && service_report.clean() && echo_exit.clean();
+  std::printf("lost: e2e %zu, secure e2e %zu, ping-pong %zu; service %s, %zu file(s) left in /dev/shm; secure "
+              "service %s, %zu file(s); echo %s\n",
+              e2e.lost, secure.lost, ping.lost, service_report.exit.describe().c_str(),
+              service_report.leaked_shm_files.size(), secure_report.exit.describe().c_str(),
+              secure_report.leaked_shm_files.size(), echo_exit.describe().c_str());
+  const bool clean = e2e.lost == 0 && secure.lost == 0 && ping.lost == 0 && service_report.clean() &&
+                     secure_report.clean() && echo_exit.clean();
   return clean ? 0 : 1;
 }
 

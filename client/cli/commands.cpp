@@ -146,6 +146,7 @@ int run_request(const RequestOptions& options, std::ostream& out, std::ostream& 
   client_options.vehicle_id = scenario.request.vehicle_id.empty() ? kDefaultVehicleId : scenario.request.vehicle_id;
   client_options.domain_id = options.domain_id;
   client_options.profiles_file = options.profiles_file;
+  client_options.security_dir = options.security_dir;
   std::optional<Client> client;
   try {
     client.emplace(client_options);

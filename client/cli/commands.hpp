@@ -32,6 +32,7 @@ struct RequestOptions {
   std::string scenario_file;
   int domain_id{0};
   std::string profiles_file;  // empty: built-in loopback-only DDS defaults
+  std::string security_dir;   // empty: no DDS Security
   double timeout_s{10.0};     // whole exchange: discovery, planning, reply
   OutputOptions output;
 };

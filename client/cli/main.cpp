@@ -51,6 +51,11 @@ int main(int argc, char** argv) {
   request_cmd
       ->add_option("--profiles", request.profiles_file, "Fast DDS XML profiles file (default: built-in, loopback only)")
       ->check(CLI::ExistingFile);
+  request_cmd
+      ->add_option("--security-dir", request.security_dir,
+                   "DDS Security credentials of the scenario's vehicle (ca.pem, cert.pem, key.pem, governance.p7s, "
+                   "permissions.p7s; scripts/make-test-pki makes test ones). Default: no security")
+      ->check(CLI::ExistingDirectory);
   request_cmd->add_option("--timeout", request.timeout_s, "Seconds to wait for the service and its answer")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

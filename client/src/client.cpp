@@ -31,6 +31,7 @@
 #include "dds_qos.hpp"
 #include "pullout/idl/convert.hpp"
 #include "pullout/idl/guarded_type.hpp"
+#include "pullout/idl/security.hpp"
 #include "pullout/msg/pulloutPubSubTypes.h"
 #include "vehicle_filter.hpp"
 
@@ -71,6 +72,11 @@ void validate_options(const ClientOptions& options) {
   if (options.domain_id < 0 || options.domain_id > kMaxDomainId) {
     throw std::invalid_argument("ClientOptions.domain_id: " + std::to_string(options.domain_id) + " is outside 0.." +
                                 std::to_string(kMaxDomainId));
+  }
+  if (!options.security_dir.empty() && !idl::is_literal_partition_name(options.vehicle_id)) {
+    throw std::invalid_argument(
+        "ClientOptions.vehicle_id: with security_dir, it names a DDS partition and may not "
+        "contain * ? [ ] or \\");
   }
 }
 
@@ -222,9 +228,20 @@ void Client::Impl::create_entities() {
                         options_.profiles_file + "'");
     }
   }
+  const bool secure = !options_.security_dir.empty();
+  if (secure) {
+    try {
+      idl::add_security_properties(options_.security_dir, participant_qos);
+    } catch (const std::invalid_argument& e) {
+      throw ClientError(std::string("security_dir: ") + e.what());
+    }
+  }
   participant_ = factory->create_participant(static_cast<dds::DomainId_t>(options_.domain_id), participant_qos);
   if (participant_ == nullptr) {
-    throw ClientError("cannot create a DDS participant on domain " + std::to_string(options_.domain_id));
+    throw ClientError("cannot create a DDS participant on domain " + std::to_string(options_.domain_id) +
+                      (secure ? " with the credentials in " + options_.security_dir +
+                                    " (the reason is in Fast DDS's log, category SECURITY)"
+                              : std::string()));
   }
   if (participant_->register_content_filter_factory(client_detail::kVehicleFilterClass, &filter_factory_) !=
       ReturnCode::RETCODE_OK) {
@@ -255,8 +272,15 @@ void Client::Impl::create_entities() {
   dds::Topic* status_topic =
       create_topic(client_detail::kStatusTopic, register_type(idl::make_guarded_type<msg::PullOutStatusPubSubType>()));
 
-  publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
-  subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  // With security, this vehicle's partition (the only one its permissions grant).
+  dds::PublisherQos publisher_qos = dds::PUBLISHER_QOS_DEFAULT;
+  dds::SubscriberQos subscriber_qos = dds::SUBSCRIBER_QOS_DEFAULT;
+  if (secure) {
+    publisher_qos.partition().push_back(options_.vehicle_id.c_str());
+    subscriber_qos.partition().push_back(options_.vehicle_id.c_str());
+  }
+  publisher_ = participant_->create_publisher(publisher_qos);
+  subscriber_ = participant_->create_subscriber(subscriber_qos);
   if (publisher_ == nullptr || subscriber_ == nullptr) throw ClientError("cannot create a DDS publisher/subscriber");
 
   request_writer_ = publisher_->create_datawriter(request_topic, writer_qos(client_detail::kRequestWriterProfile));

@@ -294,8 +294,10 @@ ServiceProcess::ServiceProcess(ServiceOptions options) : options_(std::move(opti
   const auto deadline = std::chrono::steady_clock::now() + options_.ready_timeout;
   try {
     ClientOptions probe_options;
-    probe_options.vehicle_id = "readiness-probe-" + std::to_string(::getpid());
+    probe_options.vehicle_id =
+        options_.probe_vehicle_id.empty() ? "readiness-probe-" + std::to_string(::getpid()) : options_.probe_vehicle_id;
     probe_options.domain_id = domain_;
+    probe_options.security_dir = options_.probe_security_dir;
     Client probe(probe_options);
     while (!probe.wait_for_service(kProbePeriod)) {
       if (!child_->running()) throw fail("exited before it was ready");

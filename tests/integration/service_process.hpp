@@ -114,6 +114,10 @@ struct ServiceOptions {
   std::string log_level{"warn"};
   Millis ready_timeout{20000};
   Millis stop_timeout{10000};
+  // A secure service (dds.security_dir in the config) is probed by a vehicle with credentials:
+  // its credentials directory and its vehicle id (empty: a plain probe with a made-up id).
+  std::string probe_security_dir;
+  std::string probe_vehicle_id;
 };
 
 struct StopReport {

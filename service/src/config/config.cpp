@@ -77,6 +77,26 @@ void resolve_dds(DdsConfig& d, const std::filesystem::path& config_dir, Problems
   d.profiles_file = file.string();
 }
 
+// Resolves dds.security_dir relative to the config file and checks that it holds the five
+// credential files (pullout/idl/security.hpp).
+void resolve_security(DdsConfig& d, const std::filesystem::path& config_dir, Problems& problems) {
+  if (d.security_dir.empty()) return;
+  std::filesystem::path dir(d.security_dir);
+  if (dir.is_relative()) dir = config_dir / dir;
+  dir = dir.lexically_normal();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    problems.push_back("dds.security_dir: directory not found: " + dir.string());
+    return;
+  }
+  for (const char* name : kSecurityFileNames) {
+    if (!std::filesystem::is_regular_file(dir / name, ec)) {
+      problems.push_back("dds.security_dir: " + (dir / name).string() + " not found");
+    }
+  }
+  d.security_dir = dir.string();
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -166,6 +186,7 @@ Config load_config(const std::string& path) {
     cross_key_problems(config, problems);
     const std::filesystem::path dir = std::filesystem::path(path).parent_path();
     resolve_dds(config.dds, dir, problems);
+    resolve_security(config.dds, dir, problems);
     resolve_map(config.map, dir, problems);
   }
   if (!problems.empty()) throw ConfigError(path, std::move(problems));

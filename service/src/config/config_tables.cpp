@@ -426,6 +426,9 @@ const Table<DdsConfig>& dds_table() {
       field("profiles_file", &T::profiles_file, "", NonEmpty{},
             "Fast DDS XML profiles, relative to this file; dds/network.xml for real networks"),
       field("participant_profile", &T::participant_profile, "", NonEmpty{}, "a profile of that file"),
+      field("security_dir", &T::security_dir, "", AnyValue{},
+            "DDS Security credentials (ca.pem, cert.pem, key.pem, governance.p7s, permissions.p7s), relative to "
+            "this file; empty = no security. scripts/make-test-pki makes TEST credentials"),
   }};
   return t;
 }

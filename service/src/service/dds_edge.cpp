@@ -2,13 +2,23 @@
 
 #include <exception>
 
+#include <cstring>
+#include <set>
+#include <utility>
+
+#include <fastdds/rtps/builtin/data/ReaderProxyData.h>
+#include <fastdds/rtps/builtin/data/WriterProxyData.h>
+#include <fastdds/rtps/common/InstanceHandle.h>
 #include <spdlog/spdlog.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
@@ -17,6 +27,7 @@
 
 #include "pullout/idl/convert.hpp"
 #include "pullout/idl/guarded_type.hpp"
+#include "pullout/idl/security.hpp"
 #include "pullout/model/names.hpp"
 
 namespace pullout::service {
@@ -24,6 +35,20 @@ namespace dds = eprosima::fastdds::dds;
 using ReturnCode_t = eprosima::fastrtps::types::ReturnCode_t;
 
 namespace {
+
+constexpr bool same_names(const char* a, const char* b) {
+  for (; *a != '\0' || *b != '\0'; ++a, ++b) {
+    if (*a != *b) return false;
+  }
+  return true;
+}
+constexpr bool same_security_files() {
+  for (std::size_t i = 0; i < kSecurityFileNames.size(); ++i) {
+    if (!same_names(kSecurityFileNames[i], idl::kSecurityFiles[i])) return false;
+  }
+  return kSecurityFileNames.size() == std::size(idl::kSecurityFiles);
+}
+static_assert(same_security_files(), "config.hpp's kSecurityFileNames must list pullout/idl/security.hpp's files");
 
 // Fewer instances than this in a reader or writer history means a fleet larger than that cannot
 // be served (Fast DDS's default is 10).
@@ -81,6 +106,67 @@ void check_endpoint_qos(const char* profile, const Qos& qos, dds::DurabilityQosP
 
 }  // namespace
 
+// Remembers the partitions of every remote writer the participant discovers (with security, the
+// access control plugin has checked them against the writer's permissions before the match).
+//
+// It also notes the partition of every remote path or status reader (a vehicle's: access control
+// has checked that its permissions grant that partition), so that the dispatcher creates that
+// vehicle's writers before its first reply (its client waits for them to match).
+class DdsEdge::Discovery final : public dds::DomainParticipantListener {
+ public:
+  explicit Discovery(dds::GuardCondition& wake) : wake_(wake) {}
+
+  void on_subscriber_discovery(dds::DomainParticipant* /*participant*/,
+                               eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+    using Status = eprosima::fastrtps::rtps::ReaderDiscoveryInfo;
+    if (info.status == Status::REMOVED_READER) return;
+    const std::string topic = info.info.topicName().to_string();
+    if (topic != kPathTopic && topic != kStatusTopic) return;
+    const auto& names = info.info.m_qos.m_partition.names();
+    if (names.size() != 1 || !idl::is_literal_partition_name(names.front())) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (pending_readers_.size() >= kMaxPendingVehicles) return;
+      pending_readers_.insert(names.front());
+    }
+    wake_.set_trigger_value(true);
+  }
+
+  // The vehicles whose readers were discovered since the last call.
+  std::set<std::string> take_pending() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return std::exchange(pending_readers_, {});
+  }
+
+  void on_publisher_discovery(dds::DomainParticipant* /*participant*/,
+                              eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo;
+    const auto& guid = info.info.guid();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (info.status == Status::REMOVED_WRITER) {
+      partitions_.erase(guid);
+      return;
+    }
+    partitions_[guid] = info.info.m_qos.m_partition.names();
+  }
+
+  // Whether the writer with this handle is known and its partitions are exactly {name}.
+  bool writer_partition_is(const eprosima::fastrtps::rtps::InstanceHandle_t& handle, const std::string& name) const {
+    const auto guid = eprosima::fastrtps::rtps::iHandle2GUID(handle);
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = partitions_.find(guid);
+    return it != partitions_.end() && it->second.size() == 1 && it->second.front() == name;
+  }
+
+ private:
+  // Bounds the set between two dispatcher wake-ups (only authenticated participants add to it).
+  static constexpr std::size_t kMaxPendingVehicles = 65536;
+  dds::GuardCondition& wake_;
+  mutable std::mutex mutex_;
+  std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> partitions_;
+  std::set<std::string> pending_readers_;
+};
+
 DdsEdge::DdsEdge(const DdsConfig& config) {
   try {
     create_entities(config);
@@ -100,10 +186,30 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   if (factory->load_XML_profiles_file(config.profiles_file) != ReturnCode_t::RETCODE_OK) {
     throw DdsSetupError("cannot load DDS profiles file " + config.profiles_file);
   }
-  participant_ = factory->create_participant_with_profile(config.domain_id, config.participant_profile);
-  if (participant_ == nullptr) {
-    throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
-                        config.profiles_file + " on domain " + std::to_string(config.domain_id));
+  secure_ = !config.security_dir.empty();
+  if (secure_) {
+    dds::DomainParticipantQos qos;
+    if (factory->get_participant_qos_from_profile(config.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
+      throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + config.profiles_file);
+    }
+    try {
+      idl::add_security_properties(config.security_dir, qos);
+    } catch (const std::invalid_argument& e) {
+      throw DdsSetupError(std::string("dds.security_dir: ") + e.what());
+    }
+    discovery_ = std::make_unique<Discovery>(discovery_wake_);
+    participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
+    if (participant_ == nullptr) {
+      throw DdsSetupError("cannot create the secure DDS participant with the credentials in " + config.security_dir +
+                          " (profile '" + config.participant_profile + "' of " + config.profiles_file + ", domain " +
+                          std::to_string(config.domain_id) + "): see the SECURITY errors of Fast DDS above");
+    }
+  } else {
+    participant_ = factory->create_participant_with_profile(config.domain_id, config.participant_profile);
+    if (participant_ == nullptr) {
+      throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
+                          config.profiles_file + " on domain " + std::to_string(config.domain_id));
+    }
   }
 
   request_topic_ = create_topic(*participant_, kRequestTopic, idl::make_guarded_type<msg::PullOutRequestPubSubType>());
@@ -113,7 +219,9 @@ void DdsEdge::create_entities(const DdsConfig& config) {
       create_topic(*participant_, kProgressTopic, idl::make_guarded_type<msg::ExecutionProgressPubSubType>());
 
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
-  subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  dds::SubscriberQos subscriber_qos = dds::SUBSCRIBER_QOS_DEFAULT;
+  if (secure_) subscriber_qos.partition().push_back("*");  // every vehicle's partition
+  subscriber_ = participant_->create_subscriber(subscriber_qos);
   if (publisher_ == nullptr || subscriber_ == nullptr) throw DdsSetupError("cannot create the publisher/subscriber");
 
   const auto missing_profile = [&](const char* what, const char* profile) {
@@ -161,6 +269,71 @@ void DdsEdge::destroy() noexcept {
   participant_ = nullptr;
   request_reader_ = progress_reader_ = nullptr;
   path_writer_ = status_writer_ = nullptr;
+  std::lock_guard<std::mutex> lock(vehicle_writers_mutex_);
+  vehicle_writers_.clear();  // deleted with the participant's entities
+}
+
+void DdsEdge::prepare_discovered_vehicles() {
+  if (!secure_) return;
+  discovery_wake_.set_trigger_value(false);
+  for (const std::string& vehicle_id : discovery_->take_pending()) {
+    if (writer_for(vehicle_id, true) != nullptr) spdlog::debug("vehicle '{}': writers ready", vehicle_id);
+  }
+}
+
+bool DdsEdge::sender_may_act_for(const dds::SampleInfo& info, const std::string& vehicle_id) const {
+  if (!secure_) return true;
+  return discovery_->writer_partition_is(info.publication_handle, vehicle_id);
+}
+
+dds::DataWriter* DdsEdge::writer_for(const std::string& vehicle_id, bool path) {
+  if (!secure_) return path ? path_writer_ : status_writer_;
+  std::lock_guard<std::mutex> lock(vehicle_writers_mutex_);
+  auto it = vehicle_writers_.find(vehicle_id);
+  if (it == vehicle_writers_.end()) {
+    if (!idl::is_literal_partition_name(vehicle_id)) {
+      spdlog::error("vehicle '{}': an id with * ? [ ] or \\ cannot name a DDS partition; not answered", vehicle_id);
+      return nullptr;
+    }
+    dds::PublisherQos qos = dds::PUBLISHER_QOS_DEFAULT;
+    qos.partition().push_back(vehicle_id.c_str());
+    VehicleWriters writers;
+    writers.publisher = participant_->create_publisher(qos);
+    if (writers.publisher != nullptr) {
+      writers.path = writers.publisher->create_datawriter_with_profile(path_topic_, kPathWriterProfile, nullptr,
+                                                                       dds::StatusMask::none());
+      writers.status = writers.publisher->create_datawriter_with_profile(status_topic_, kStatusWriterProfile, nullptr,
+                                                                         dds::StatusMask::none());
+    }
+    if (writers.path == nullptr || writers.status == nullptr) {
+      spdlog::error("vehicle '{}': cannot create its path/status writers in partition '{}' (permissions?)", vehicle_id,
+                    vehicle_id);
+      delete_vehicle_writers(writers);
+      return nullptr;
+    }
+    it = vehicle_writers_.emplace(vehicle_id, writers).first;
+  }
+  return path ? it->second.path : it->second.status;
+}
+
+void DdsEdge::delete_vehicle_writers(VehicleWriters& writers) noexcept {
+  if (writers.publisher == nullptr) return;
+  if (writers.publisher->delete_contained_entities() != ReturnCode_t::RETCODE_OK ||
+      participant_->delete_publisher(writers.publisher) != ReturnCode_t::RETCODE_OK) {
+    spdlog::error("DDS: cannot delete a vehicle's publisher");
+  }
+  writers = VehicleWriters{};
+}
+
+void DdsEdge::forget_vehicle(const std::string& vehicle_id) {
+  if (!secure_) return;
+  // The path and status locks: no write of this vehicle is in progress on its writers.
+  std::scoped_lock writes(path_mutex_, status_mutex_);
+  std::lock_guard<std::mutex> lock(vehicle_writers_mutex_);
+  const auto it = vehicle_writers_.find(vehicle_id);
+  if (it == vehicle_writers_.end()) return;
+  delete_vehicle_writers(it->second);
+  vehicle_writers_.erase(it);
 }
 
 bool DdsEdge::publish_path(const PullOutPath& path) {
@@ -169,7 +342,8 @@ bool DdsEdge::publish_path(const PullOutPath& path) {
   {
     std::lock_guard<std::mutex> lock(path_mutex_);
     try {
-      ok = path_writer_->write(&sample);
+      dds::DataWriter* writer = writer_for(path.vehicle_id, true);
+      ok = writer != nullptr && writer->write(&sample);
     } catch (const std::exception& e) {
       spdlog::error("write {}: {}", kPathTopic, e.what());
     }
@@ -187,7 +361,8 @@ bool DdsEdge::publish_status(const PullOutStatus& status) {
   {
     std::lock_guard<std::mutex> lock(status_mutex_);
     try {
-      ok = status_writer_->write(&sample);
+      dds::DataWriter* writer = writer_for(status.vehicle_id, false);
+      ok = writer != nullptr && writer->write(&sample);
     } catch (const std::exception& e) {
       spdlog::error("write {}: {}", kStatusTopic, e.what());
     }

@@ -9,11 +9,24 @@
 // Construction loads the XML and creates everything, or throws DdsSetupError naming the step that
 // failed (after deleting whatever was created). Destruction deletes every entity and the
 // participant, which also removes the participant's shared-memory files.
+//
+// Secure mode (config.security_dir set; pullout/idl/security.hpp): the participant authenticates
+// with those credentials, the readers take every partition ("*"), and each vehicle's path and
+// status are written by writers of their own in the partition named after the vehicle id
+// (created on the vehicle's first reply, deleted by forget_vehicle). A sample is the vehicle's
+// only if its writer is in that vehicle's partition (sender_may_act_for), which the vehicle's
+// permissions document alone grants.
 #pragma once
 
+#include <map>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <fastdds/dds/core/condition/GuardCondition.hpp>
 
 #include "pullout/config/config.hpp"
 #include "pullout/idl/topics.hpp"
@@ -26,6 +39,7 @@ class Subscriber;
 class Topic;
 class DataReader;
 class DataWriter;
+struct SampleInfo;
 }  // namespace eprosima::fastdds::dds
 
 namespace pullout::service {
@@ -55,14 +69,39 @@ class DdsEdge final : public Outbox {
   bool publish_path(const PullOutPath& path) override;
   bool publish_status(const PullOutStatus& status) override;
 
+  // Whether DDS Security is on (per-vehicle partitions).
+  bool secure() const { return secure_; }
+  // Whether the writer of a sample (its SampleInfo) may speak for `vehicle_id`: always without
+  // security; with security only a writer whose partitions are exactly {vehicle_id}. A sample
+  // from a writer not (yet) discovered is refused. Thread-safe.
+  bool sender_may_act_for(const eprosima::fastdds::dds::SampleInfo& info, const std::string& vehicle_id) const;
+  // Secure mode: triggered when a vehicle's reader is discovered; the dispatcher then calls
+  // prepare_discovered_vehicles (which creates that vehicle's writers and resets the trigger).
+  eprosima::fastdds::dds::GuardCondition& discovery_condition() { return discovery_wake_; }
+  void prepare_discovered_vehicles();
+  // Secure mode: deletes the vehicle's writers (its path and status instances go with them).
+  // Without security: nothing. Thread-safe.
+  void forget_vehicle(const std::string& vehicle_id);
+
   // For the dispatcher thread only (take samples, wait on their status conditions).
   eprosima::fastdds::dds::DataReader& request_reader() { return *request_reader_; }
   eprosima::fastdds::dds::DataReader& progress_reader() { return *progress_reader_; }
 
  private:
+  class Discovery;  // the participant listener: the partitions of every discovered writer
+  // One vehicle's writers in secure mode, in a publisher whose partition is the vehicle id.
+  struct VehicleWriters {
+    eprosima::fastdds::dds::Publisher* publisher{nullptr};
+    eprosima::fastdds::dds::DataWriter* path{nullptr};
+    eprosima::fastdds::dds::DataWriter* status{nullptr};
+  };
+
   void create_entities(const DdsConfig& config);
   void check_qos() const;
   void destroy() noexcept;
+  // The writer for this vehicle's paths (`path` true) or statuses; null when it cannot be created.
+  eprosima::fastdds::dds::DataWriter* writer_for(const std::string& vehicle_id, bool path);
+  void delete_vehicle_writers(VehicleWriters& writers) noexcept;
 
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
   eprosima::fastdds::dds::Publisher* publisher_{nullptr};
@@ -79,6 +118,12 @@ class DdsEdge final : public Outbox {
   // one type from several threads are serialised here.
   std::mutex path_mutex_;
   std::mutex status_mutex_;
+
+  bool secure_{false};
+  eprosima::fastdds::dds::GuardCondition discovery_wake_;
+  std::unique_ptr<Discovery> discovery_;
+  std::mutex vehicle_writers_mutex_;  // guards vehicle_writers_
+  std::unordered_map<std::string, VehicleWriters> vehicle_writers_;
 };
 
 }  // namespace pullout::service

@@ -84,6 +84,7 @@ void PulloutService::dispatch_loop() {
   waitset.attach_condition(requests);
   waitset.attach_condition(progress);
   waitset.attach_condition(shutdown_);
+  if (dds_.secure()) waitset.attach_condition(dds_.discovery_condition());
   spdlog::debug("dispatcher running");
 
   auto last_time_tick = std::chrono::steady_clock::now();
@@ -95,6 +96,7 @@ void PulloutService::dispatch_loop() {
       spdlog::error("dispatcher: WaitSet::wait failed (code {})", rc());
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
+    dds_.prepare_discovered_vehicles();
     // Both readers are drained on every wake-up: cheap when empty, and it cannot miss data.
     take_requests();
     take_progress();
@@ -109,6 +111,7 @@ void PulloutService::dispatch_loop() {
   waitset.detach_condition(requests);
   waitset.detach_condition(progress);
   waitset.detach_condition(shutdown_);
+  if (dds_.secure()) waitset.detach_condition(dds_.discovery_condition());
   spdlog::debug("dispatcher stopped");
 }
 
@@ -119,7 +122,7 @@ void PulloutService::take_requests() {
   while (!stopping_) {
     try {
       if (reader.take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return;
-      if (info.valid_data) handle_request(sample);
+      if (info.valid_data && sender_allowed(info, sample.vehicle_id(), "request")) handle_request(sample);
     } catch (const std::exception& e) {
       // One bad sample (say an allocation failure on a huge one) must not take the service down.
       spdlog::error("request dropped: {}", e.what());
@@ -134,11 +137,25 @@ void PulloutService::take_progress() {
   while (!stopping_) {
     try {
       if (reader.take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return;
-      if (info.valid_data) handle_progress(sample);
+      if (info.valid_data && sender_allowed(info, sample.vehicle_id(), "progress")) handle_progress(sample);
     } catch (const std::exception& e) {
       spdlog::error("progress sample dropped: {}", e.what());
     }
   }
+}
+
+bool PulloutService::sender_allowed(const dds::SampleInfo& info, const std::string& vehicle_id, const char* what) {
+  if (dds_.sender_may_act_for(info, vehicle_id)) return true;
+  // Refused samples are counted and logged at most once per kProgressWarnInterval: a hostile
+  // sender must not flood the log.
+  ++refused_samples_;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - refused_logged_ >= kProgressWarnInterval) {
+    refused_logged_ = now;
+    spdlog::warn("{} for vehicle '{}' refused: its writer is not in that vehicle's partition ({} refused so far)", what,
+                 vehicle_id.substr(0, kMaxVehicleIdBytes), refused_samples_);
+  }
+  return false;
 }
 
 void PulloutService::handle_request(const msg::PullOutRequest& sample) {

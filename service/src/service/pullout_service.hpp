@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -58,6 +59,9 @@ class PulloutService {
   void dispatch_loop();
   void take_requests();
   void take_progress();
+  // Whether the sample's writer may speak for vehicle_id (DdsEdge::sender_may_act_for); logs a
+  // refusal, rate-limited.
+  bool sender_allowed(const eprosima::fastdds::dds::SampleInfo& info, const std::string& vehicle_id, const char* what);
   void handle_request(const msg::PullOutRequest& sample);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
@@ -73,6 +77,9 @@ class PulloutService {
   // Dispatcher thread only: when each vehicle last had a malformed progress sample logged, so that
   // a sender stuck at 50 Hz does not flood the log.
   std::unordered_map<std::string, std::chrono::steady_clock::time_point> progress_warned_;
+  // Dispatcher thread only: samples refused because their writer may not speak for their vehicle.
+  std::uint64_t refused_samples_{0};
+  std::chrono::steady_clock::time_point refused_logged_{};
   // Last: destroyed (workers joined) before the registry and the DDS entities they use.
   std::unique_ptr<PlanningQueue> queue_;
 };

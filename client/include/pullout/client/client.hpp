@@ -58,6 +58,13 @@ struct ClientOptions {
   std::string profiles_file;
   // Participant profile in profiles_file (ignored when profiles_file is empty).
   std::string participant_profile{"pullout_participant"};
+  // DDS Security: a directory with this vehicle's credentials (ca.pem, cert.pem, key.pem,
+  // governance.p7s, permissions.p7s; scripts/make-test-pki makes TEST ones). Empty: no security.
+  // When set, the client authenticates, its samples are encrypted as the governance says, and its
+  // endpoints live in the DDS partition named vehicle_id (which its permissions must grant), so
+  // vehicle_id may not contain * ? [ ] or \. The service must run with security too
+  // (dds.security_dir). README, "DDS Security".
+  std::string security_dir;
 };
 
 // A DDS failure: the participant, a topic or an endpoint could not be created, a profiles file

@@ -33,7 +33,16 @@ struct DdsConfig {
   // load_config resolves it relative to the config file and checks that it exists.
   std::string profiles_file{"dds/loopback.xml"};
   std::string participant_profile{"pullout_participant"};
+  // DDS Security credentials of the service (a directory with kSecurityFileNames; load_config
+  // resolves it relative to the config file). Empty: no security. When set, every vehicle's
+  // samples live in the partition named after its vehicle id (pullout/idl/security.hpp).
+  std::string security_dir;
 };
+
+// The files of a DDS Security credentials directory (the same list as pullout/idl/security.hpp,
+// which this header cannot include: it has no DDS dependency).
+inline constexpr std::array<const char*, 5> kSecurityFileNames{"ca.pem", "cert.pem", "key.pem", "governance.p7s",
+                                                               "permissions.p7s"};
 
 // spdlog's level names: the values of service.log_level and pullout_service --log-level.
 inline constexpr std::array<const char*, 7> kLogLevels{"trace", "debug", "info", "warn", "error", "critical", "off"};
