@@ -163,6 +163,43 @@ void DdsEdge::destroy() noexcept {
   path_writer_ = status_writer_ = nullptr;
 }
 
+int DdsEdge::instance_capacity() const {
+  int capacity = 0;
+  const auto take = [&](int instances) {
+    if (instances > 0 && (capacity == 0 || instances < capacity)) capacity = instances;
+  };
+  take(request_reader_->get_qos().resource_limits().max_instances);
+  take(progress_reader_->get_qos().resource_limits().max_instances);
+  take(path_writer_->get_qos().resource_limits().max_instances);
+  take(status_writer_->get_qos().resource_limits().max_instances);
+  return capacity;
+}
+
+bool DdsEdge::forget_vehicle(const std::string& vehicle_id) {
+  bool ok = true;
+  {
+    msg::PullOutPath key;
+    key.vehicle_id(vehicle_id);
+    std::lock_guard<std::mutex> lock(path_mutex_);
+    const ReturnCode_t rc = path_writer_->unregister_instance(&key, dds::HANDLE_NIL);
+    if (rc != ReturnCode_t::RETCODE_OK) {
+      spdlog::error("unregister {} instance of vehicle '{}' failed (code {})", kPathTopic, vehicle_id, rc());
+      ok = false;
+    }
+  }
+  {
+    msg::PullOutStatus key;
+    key.vehicle_id(vehicle_id);
+    std::lock_guard<std::mutex> lock(status_mutex_);
+    const ReturnCode_t rc = status_writer_->unregister_instance(&key, dds::HANDLE_NIL);
+    if (rc != ReturnCode_t::RETCODE_OK) {
+      spdlog::error("unregister {} instance of vehicle '{}' failed (code {})", kStatusTopic, vehicle_id, rc());
+      ok = false;
+    }
+  }
+  return ok;
+}
+
 bool DdsEdge::publish_path(const PullOutPath& path) {
   msg::PullOutPath sample = idl::to_msg(path);
   bool ok = false;

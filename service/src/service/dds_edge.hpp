@@ -54,6 +54,14 @@ class DdsEdge final : public Outbox {
 
   bool publish_path(const PullOutPath& path) override;
   bool publish_status(const PullOutStatus& status) override;
+  // Unregisters the vehicle's path and status instances (with the writers' default
+  // autodispose_unregistered_instances, readers see them disposed): the writers free the
+  // instances, so that max_instances bounds the vehicles served at once, not over a lifetime.
+  bool forget_vehicle(const std::string& vehicle_id) override;
+
+  // The smallest resource_limits.max_instances of the four endpoints (0: unlimited): the most
+  // vehicles the service can hold sessions for.
+  int instance_capacity() const;
 
   // For the dispatcher thread only (take samples, wait on their status conditions).
   eprosima::fastdds::dds::DataReader& request_reader() { return *request_reader_; }

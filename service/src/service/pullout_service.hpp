@@ -13,12 +13,14 @@
 
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <unordered_map>
 
+#include <fastdds/rtps/common/InstanceHandle.h>
 #include <fastdds/dds/core/condition/GuardCondition.hpp>
 
 #include "pullout/config/config.hpp"
@@ -26,6 +28,10 @@
 #include "service/dds_edge.hpp"
 #include "service/planning_queue.hpp"
 #include "service/vehicle_registry.hpp"
+
+namespace eprosima::fastdds::dds {
+struct SampleInfo;
+}  // namespace eprosima::fastdds::dds
 
 namespace pullout::msg {
 class PullOutRequest;
@@ -58,6 +64,11 @@ class PulloutService {
   void dispatch_loop();
   void take_requests();
   void take_progress();
+  // Which vehicle each instance of a reader belongs to: a sample telling that an instance is no
+  // longer alive carries no key fields. An entry lives as long as the reader's instance (erased
+  // when it is reported gone), so max_instances bounds the map.
+  using InstanceNames = std::map<eprosima::fastrtps::rtps::InstanceHandle_t, std::string>;
+  void instance_gone(InstanceNames& names, const eprosima::fastdds::dds::SampleInfo& info, VehicleInput input);
   void handle_request(const msg::PullOutRequest& sample);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
@@ -73,6 +84,9 @@ class PulloutService {
   // Dispatcher thread only: when each vehicle last had a malformed progress sample logged, so that
   // a sender stuck at 50 Hz does not flood the log.
   std::unordered_map<std::string, std::chrono::steady_clock::time_point> progress_warned_;
+  // Dispatcher thread only.
+  InstanceNames request_instances_;
+  InstanceNames progress_instances_;
   // Last: destroyed (workers joined) before the registry and the DDS entities they use.
   std::unique_ptr<PlanningQueue> queue_;
 };
