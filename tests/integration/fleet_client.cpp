@@ -103,7 +103,8 @@ bool FleetClient::forget(const std::string& vehicle_id, bool await_gone) {
   for (auto it = statuses_.begin(); it != statuses_.end();) {
     it = it->first.first == vehicle_id ? statuses_.erase(it) : std::next(it);
   }
-  for (auto it = paths_.begin(); it != paths_.end();) it = it->first.first == vehicle_id ? paths_.erase(it) : std::next(it);
+  for (auto it = paths_.begin(); it != paths_.end();)
+    it = it->first.first == vehicle_id ? paths_.erase(it) : std::next(it);
   msg::PullOutRequest key;
   key.vehicle_id(vehicle_id);
   return request_writer_->unregister_instance(&key, dds::HANDLE_NIL) == ReturnCode_t::RETCODE_OK;

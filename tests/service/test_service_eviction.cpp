@@ -6,8 +6,10 @@
 // config with service.max_vehicles = kMaxVehicles. The clients are FleetClients: one participant
 // speaking for many vehicles in turn (tests/integration/fleet_client.hpp).
 //
-// Before eviction (main at 107480b) the service answered exactly kInstances vehicles and then
-// nobody: every DDS instance of its path and status writers stayed registered.
+// Before eviction (main at 107480b, the config without the new keys) the service answered exactly
+// kInstances vehicles and then nobody (every instance of its path and status writers stayed
+// registered); and with clients that unregister, it answered nobody after the first: its readers'
+// DYNAMIC_REUSABLE memory policy stalls on an unregister sample (config/dds/loopback.xml).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -47,7 +49,8 @@ std::string replace_all(std::string text, const std::string& from, const std::st
 std::string small_profiles() {
   const std::string original = read_text(kSourceDir + "/config/dds/loopback.xml");
   const std::string n = std::to_string(kInstances);
-  std::string text = replace_all(original, "<max_instances>4096</max_instances>", "<max_instances>" + n + "</max_instances>");
+  std::string text =
+      replace_all(original, "<max_instances>4096</max_instances>", "<max_instances>" + n + "</max_instances>");
   text = replace_all(text, "<max_samples>4096</max_samples>", "<max_samples>" + n + "</max_samples>");
   return text;
 }
@@ -95,8 +98,7 @@ TEST_F(ServiceEviction, VehiclesThatLeaveFreeTheirPlace) {
     const std::string vehicle = "churn-" + std::to_string(i);
     ASSERT_TRUE(client_->send(request_for(vehicle, 1000 + i))) << vehicle;
     const auto answer = client_->wait_answer(vehicle, 1000 + i, kAnswerTimeout);
-    ASSERT_TRUE(answer.has_value()) << vehicle << " (vehicle " << i + 1 << " of " << kVehicles
-                                    << ") was not answered\n"
+    ASSERT_TRUE(answer.has_value()) << vehicle << " (vehicle " << i + 1 << " of " << kVehicles << ") was not answered\n"
                                     << service_->stderr_tail();
     EXPECT_EQ(answer->status.state, ExecutionState::kWaitingApproval) << vehicle << answer->status.error;
     EXPECT_TRUE(answer->path.found) << vehicle;
@@ -104,7 +106,8 @@ TEST_F(ServiceEviction, VehiclesThatLeaveFreeTheirPlace) {
     ASSERT_TRUE(client_->forget(vehicle, true)) << vehicle;
     // The service saw the vehicle go and evicted it (its path instance unregistered). The writer
     // frees an unregistered instance once every reader acknowledged it (next heartbeat, 200 ms).
-    ASSERT_TRUE(client_->wait_path_gone(vehicle, kAnswerTimeout)) << vehicle << " was not evicted\n" << service_->stderr_tail();
+    ASSERT_TRUE(client_->wait_path_gone(vehicle, kAnswerTimeout)) << vehicle << " was not evicted\n"
+                                                                  << service_->stderr_tail();
   }
 }
 
@@ -130,6 +133,26 @@ TEST_F(ServiceEviction, FullServiceEvictsTheLeastRecentlyActiveIdleVehicle) {
   const auto again = client_->wait_answer("stay-0", 2100, kAnswerTimeout);
   ASSERT_TRUE(again.has_value()) << service_->stderr_tail();
   EXPECT_EQ(again->status.state, ExecutionState::kWaitingApproval);
+}
+
+// A max_vehicles the profiles' instances cannot hold stops the service at start-up, naming both.
+TEST(ServiceEvictionConfig, MaxVehiclesAboveMaxInstancesStopsTheService) {
+  integration::TempDir dir;
+  integration::DomainLease lease;
+  const std::string profiles = dir.write_file("small.xml", small_profiles());
+  const std::string config =
+      dir.write_file("pullout.yaml", "service:\n  max_vehicles: " + std::to_string(2 * kInstances) +
+                                         "\ndds:\n  profiles_file: " + profiles + "\n");
+  integration::ChildProcess service(
+      {PULLOUT_SERVICE_EXE, "--config", config, "--domain", std::to_string(lease.domain())}, dir.path() + "/out",
+      dir.path() + "/err");
+  const auto exit = service.wait_exit(20000ms);
+  ASSERT_TRUE(exit.has_value()) << "the service did not stop";
+  EXPECT_TRUE(exit->exited && exit->exit_code != 0 && exit->exit_code != integration::kSanitizerExitCode)
+      << exit->describe();
+  const std::string err = read_text(dir.path() + "/err");
+  EXPECT_NE(err.find("service.max_vehicles = 32"), std::string::npos) << err;
+  EXPECT_NE(err.find("max_instances = 16"), std::string::npos) << err;
 }
 
 }  // namespace
