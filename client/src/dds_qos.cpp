@@ -48,7 +48,10 @@ dds::DataReaderQos reply_reader_qos(int depth) {
   qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
   qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   qos.history().depth = depth;
-  qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  // Not DYNAMIC*: a Fast DDS 2.9.1 reader with a dynamic payload pool never accepts the key-only
+  // sample of an unregister (the service unregisters an evicted vehicle's path and status) and
+  // then holds back every later sample of that writer (config/dds/loopback.xml).
+  qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return qos;
 }
 

@@ -312,6 +312,41 @@ TEST_F(Session, AResentRequestIsValidatedInFullBeforeItsObjectsAreKept) {
   }
 }
 
+TEST_F(Session, ARejectedRequestKeepsNothingOfItOrOfThePathBefore) {
+  PullOutRequest good = test::straight_shoulder_request();
+  good.objects = {test::parked_car(5, 60.0, -8.0)};
+  ASSERT_TRUE(plan(good).path->found);
+  ASSERT_GT(session_->retained().path_points, 0u);  // the followed path
+  // Over the objects limit: more objects than a session may keep, none of them kept.
+  PullOutRequest huge = test::straight_shoulder_request();
+  huge.request_id = 2;
+  huge.objects.assign(RequestLimits{}.max_objects + 1, test::parked_car(5, 60.0, -8.0));
+  const SessionEffects e = session_->on_request(huge, {}, now_);
+  ASSERT_TRUE(e.status);
+  ASSERT_EQ(e.status->state, ExecutionState::kRejected);
+  EXPECT_EQ(session_->retained().objects, 0u);
+  EXPECT_EQ(session_->retained().path_points, 0u);
+}
+
+TEST_F(Session, ObjectsAreNotKeptOnceTheSearchReturned) {
+  PullOutRequest r = test::straight_shoulder_request();
+  r.objects = {test::parked_car(5, 60.0, -8.0), test::parked_car(6, 70.0, -8.0)};
+  SessionEffects ordered = session_->on_request(r, {}, now_);
+  ASSERT_TRUE(ordered.search);
+  EXPECT_EQ(session_->retained().objects, 2u);  // for the safety check of the path to come
+  const PlanningResult result = planner_->plan(ordered.search->request, StopCondition());
+  ASSERT_TRUE(session_->on_result(ordered.search->sequence, result, now_).path->found);
+  EXPECT_EQ(session_->retained().objects, 0u);  // the safety monitor holds them now
+  // A no-path keeps no path points either.
+  const Scenario boxed = scenario("boxed_in");
+  use(boxed);
+  const SessionEffects none = plan(boxed.request);
+  ASSERT_TRUE(none.status);
+  ASSERT_EQ(none.status->state, ExecutionState::kNoPath);
+  EXPECT_EQ(session_->retained().objects, 0u);
+  EXPECT_EQ(session_->retained().path_points, 0u);
+}
+
 TEST_F(Session, AfterDepartureTheFollowedPathIsLatchedAndKeepsItsSegment) {
   const Scenario sc = scenario("car_close_ahead");
   use(sc);

@@ -55,10 +55,23 @@ PullOutPath VehicleSession::stamped(PullOutPath path) const {
   return path;
 }
 
+VehicleSession::Retained VehicleSession::retained() const {
+  const auto points = [](const PullOutPath& p) {
+    std::size_t n = 0;
+    for (const auto& segment : p.partial_paths) n += segment.points.size();
+    return n;
+  };
+  Retained r;
+  r.objects = objects_.size();
+  r.path_points = (path_ ? points(*path_) : 0) + points(published_);
+  return r;
+}
+
 void VehicleSession::forget_path() {
   tracker_.clear();
   path_.reset();
   safety_.reset();
+  published_ = PullOutPath{};  // its storage goes with it
   stop_inserted_ = false;
   last_sample_.reset();
   refused_.reset();
@@ -73,7 +86,7 @@ void VehicleSession::supersede() {
 
 SessionEffects VehicleSession::reject(std::uint64_t request_id, const std::vector<RequestIssue>& issues) {
   supersede();
-  objects_.clear();
+  objects_ = std::vector<Object>{};  // clear() would keep the capacity
   SessionEffects out;
   out.cancel_search = true;
   PullOutPath path;
@@ -108,7 +121,6 @@ SessionEffects VehicleSession::on_request(PullOutRequest request, const std::vec
     if (latched || throttled) {
       // Objects only: the same path under the new request id, segment index kept.
       ++sequence_;
-      objects_ = request.objects;
       safety_->update_objects(std::move(request.objects));
       path_->request_id = request.request_id;
       published_.request_id = request.request_id;
@@ -208,6 +220,7 @@ SessionEffects VehicleSession::on_result(std::uint64_t sequence, const PlanningR
     }
   }
   signal_carry_.reset();
+  objects_ = std::vector<Object>{};  // the safety monitor has its copy; nothing else needs them
   (void)now;
   status_ = status;
   out.path = stamped(std::move(path));
@@ -221,7 +234,8 @@ SessionEffects VehicleSession::on_search_failed(std::uint64_t sequence, const st
   if (sequence == 0 || sequence != pending_) return out;
   (void)now;
   pending_ = 0;
-  tracker_.clear();
+  forget_path();
+  objects_ = std::vector<Object>{};
   const std::string reason = "internal error: " + what;
   PullOutPath path;
   path.request_id = status_.request_id;

@@ -412,6 +412,17 @@ const Table<ServiceConfig>& service_table() {
       field("log_level", &T::log_level, "", Choices{{kLogLevels.begin(), kLogLevels.end()}}, ""),
       field("progress_timeout_s", &T::progress_timeout_s, "s", in(0.0, 60.0),
             "a departed vehicle silent this long is told to stop (odometry lost); 0 = never"),
+      note<T>("Vehicle sessions. A session is evicted (its path and status instances unregistered on the\n"
+              "DDS writers, one log line) when it is idle, that is no search running and not driving a path\n"
+              "(departed, not completed), and either its vehicle's request and progress writers are gone or\n"
+              "it had no request and no progress for session_idle_timeout_s. A vehicle driving a path is\n"
+              "evicted only when its writers are gone and it was silent that long. When max_vehicles are\n"
+              "held, a new vehicle evicts the least recently active idle one; when none is idle it is\n"
+              "rejected (status rejected, error 'service.max_vehicles: ...'). About 85 KB per session.\n"
+              "max_vehicles must not exceed resource_limits.max_instances of the DDS profiles (checked at\n"
+              "start-up): each session holds one instance on the path and on the status writer."),
+      field("session_idle_timeout_s", &T::session_idle_timeout_s, "s", in(0.0, 86400.0), "0 = never by time"),
+      field("max_vehicles", &T::max_vehicles, "", in(1, 1000000), "sessions held at once"),
       note<T>("Size limits of one request; a larger request is rejected with the field named."),
       group("limits", &T::limits, &limits_table, ""),
   }};

@@ -325,8 +325,7 @@ void DdsEdge::delete_vehicle_writers(VehicleWriters& writers) noexcept {
   writers = VehicleWriters{};
 }
 
-void DdsEdge::forget_vehicle(const std::string& vehicle_id) {
-  if (!secure_) return;
+void DdsEdge::forget_secure_vehicle(const std::string& vehicle_id) {
   // The path and status locks: no write of this vehicle is in progress on its writers.
   std::scoped_lock writes(path_mutex_, status_mutex_);
   std::lock_guard<std::mutex> lock(vehicle_writers_mutex_);
@@ -334,6 +333,47 @@ void DdsEdge::forget_vehicle(const std::string& vehicle_id) {
   if (it == vehicle_writers_.end()) return;
   delete_vehicle_writers(it->second);
   vehicle_writers_.erase(it);
+}
+
+int DdsEdge::instance_capacity() const {
+  int capacity = 0;
+  const auto take = [&](int instances) {
+    if (instances > 0 && (capacity == 0 || instances < capacity)) capacity = instances;
+  };
+  take(request_reader_->get_qos().resource_limits().max_instances);
+  take(progress_reader_->get_qos().resource_limits().max_instances);
+  take(path_writer_->get_qos().resource_limits().max_instances);
+  take(status_writer_->get_qos().resource_limits().max_instances);
+  return capacity;
+}
+
+bool DdsEdge::forget_vehicle(const std::string& vehicle_id) {
+  if (secure_) {
+    forget_secure_vehicle(vehicle_id);
+    return true;
+  }
+  bool ok = true;
+  {
+    msg::PullOutPath key;
+    key.vehicle_id(vehicle_id);
+    std::lock_guard<std::mutex> lock(path_mutex_);
+    const ReturnCode_t rc = path_writer_->unregister_instance(&key, dds::HANDLE_NIL);
+    if (rc != ReturnCode_t::RETCODE_OK) {
+      spdlog::error("unregister {} instance of vehicle '{}' failed (code {})", kPathTopic, vehicle_id, rc());
+      ok = false;
+    }
+  }
+  {
+    msg::PullOutStatus key;
+    key.vehicle_id(vehicle_id);
+    std::lock_guard<std::mutex> lock(status_mutex_);
+    const ReturnCode_t rc = status_writer_->unregister_instance(&key, dds::HANDLE_NIL);
+    if (rc != ReturnCode_t::RETCODE_OK) {
+      spdlog::error("unregister {} instance of vehicle '{}' failed (code {})", kStatusTopic, vehicle_id, rc());
+      ok = false;
+    }
+  }
+  return ok;
 }
 
 bool DdsEdge::publish_path(const PullOutPath& path) {

@@ -68,6 +68,16 @@ class DdsEdge final : public Outbox {
 
   bool publish_path(const PullOutPath& path) override;
   bool publish_status(const PullOutStatus& status) override;
+  // Unregisters the vehicle's path and status instances (with the writers' default
+  // autodispose_unregistered_instances, readers see them disposed): the writers free the
+  // instances, so that max_instances bounds the vehicles served at once, not over a lifetime.
+  // Secure mode: deletes the vehicle's own writers instead (its readers see the instances with
+  // no writer). Thread-safe.
+  bool forget_vehicle(const std::string& vehicle_id) override;
+
+  // The smallest resource_limits.max_instances of the four endpoints (0: unlimited): the most
+  // vehicles the service can hold sessions for.
+  int instance_capacity() const;
 
   // Whether DDS Security is on (per-vehicle partitions).
   bool secure() const { return secure_; }
@@ -79,9 +89,6 @@ class DdsEdge final : public Outbox {
   // prepare_discovered_vehicles (which creates that vehicle's writers and resets the trigger).
   eprosima::fastdds::dds::GuardCondition& discovery_condition() { return discovery_wake_; }
   void prepare_discovered_vehicles();
-  // Secure mode: deletes the vehicle's writers (its path and status instances go with them).
-  // Without security: nothing. Thread-safe.
-  void forget_vehicle(const std::string& vehicle_id);
 
   // For the dispatcher thread only (take samples, wait on their status conditions).
   eprosima::fastdds::dds::DataReader& request_reader() { return *request_reader_; }
@@ -102,6 +109,7 @@ class DdsEdge final : public Outbox {
   // The writer for this vehicle's paths (`path` true) or statuses; null when it cannot be created.
   eprosima::fastdds::dds::DataWriter* writer_for(const std::string& vehicle_id, bool path);
   void delete_vehicle_writers(VehicleWriters& writers) noexcept;
+  void forget_secure_vehicle(const std::string& vehicle_id);
 
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
   eprosima::fastdds::dds::Publisher* publisher_{nullptr};

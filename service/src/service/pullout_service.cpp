@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <iterator>
 #include <mutex>
 #include <utility>
 #include <vector>
@@ -41,13 +42,31 @@ const char* outcome_name(PlanningResult::Outcome o) {
   return "?";
 }
 
+RegistryOptions registry_options(const ServiceConfig& service) {
+  RegistryOptions o;
+  o.session.progress_timeout_s = service.progress_timeout_s;
+  o.session_idle_timeout_s = service.session_idle_timeout_s;
+  o.max_vehicles = service.max_vehicles;
+  return o;
+}
+
 }  // namespace
 
 PulloutService::PulloutService(const Config& config, std::shared_ptr<const LaneletMap> map)
     : config_(config),
       dds_(config.dds),
       planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
-      registry_(planner_, dds_, SessionOptions{config.service.progress_timeout_s}) {
+      registry_(planner_, dds_, registry_options(config.service)) {
+  // Every session holds one instance on the path and on the status writer, and a vehicle that is
+  // served has one on each reader: a profile with fewer instances than sessions stops answering
+  // new vehicles without a word once full.
+  const int capacity = dds_.instance_capacity();
+  if (capacity > 0 && config.service.max_vehicles > static_cast<std::size_t>(capacity)) {
+    throw DdsSetupError("service.max_vehicles = " + std::to_string(config.service.max_vehicles) +
+                        " exceeds resource_limits.max_instances = " + std::to_string(capacity) +
+                        " of the DDS profiles in " + config.dds.profiles_file +
+                        ": lower max_vehicles or raise max_instances");
+  }
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
 }
 
@@ -104,6 +123,10 @@ void PulloutService::dispatch_loop() {
     if (now - last_time_tick >= kSessionTimePeriod) {
       last_time_tick = now;
       registry_.on_time();
+      // Bounded like the sessions: entries older than the interval say nothing any more.
+      for (auto it = progress_warned_.begin(); it != progress_warned_.end();) {
+        it = now - it->second >= kProgressWarnInterval ? progress_warned_.erase(it) : std::next(it);
+      }
     }
   }
 
@@ -122,7 +145,13 @@ void PulloutService::take_requests() {
   while (!stopping_) {
     try {
       if (reader.take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return;
-      if (info.valid_data && sender_allowed(info, sample.vehicle_id(), "request")) handle_request(sample);
+      if (info.valid_data) {
+        if (!sender_allowed(info, sample.vehicle_id(), "request")) continue;
+        request_instances_[info.instance_handle] = sample.vehicle_id();
+        handle_request(sample);
+      } else {
+        instance_gone(request_instances_, info, VehicleInput::kRequest);
+      }
     } catch (const std::exception& e) {
       // One bad sample (say an allocation failure on a huge one) must not take the service down.
       spdlog::error("request dropped: {}", e.what());
@@ -137,7 +166,13 @@ void PulloutService::take_progress() {
   while (!stopping_) {
     try {
       if (reader.take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return;
-      if (info.valid_data && sender_allowed(info, sample.vehicle_id(), "progress")) handle_progress(sample);
+      if (info.valid_data) {
+        if (!sender_allowed(info, sample.vehicle_id(), "progress")) continue;
+        progress_instances_[info.instance_handle] = sample.vehicle_id();
+        handle_progress(sample);
+      } else {
+        instance_gone(progress_instances_, info, VehicleInput::kProgress);
+      }
     } catch (const std::exception& e) {
       spdlog::error("progress sample dropped: {}", e.what());
     }
@@ -156,6 +191,19 @@ bool PulloutService::sender_allowed(const dds::SampleInfo& info, const std::stri
                  vehicle_id.substr(0, kMaxVehicleIdBytes), refused_samples_);
   }
   return false;
+}
+
+void PulloutService::instance_gone(InstanceNames& names, const dds::SampleInfo& info, VehicleInput input) {
+  if (info.instance_state == dds::ALIVE_INSTANCE_STATE) return;
+  const auto it = names.find(info.instance_handle);
+  if (it == names.end()) return;
+  // With security, only the vehicle's own writers can end its instances (a dispose written by
+  // another vehicle's writer must not make this one look gone).
+  if (!dds_.sender_may_act_for(info, it->second)) return;
+  spdlog::debug("vehicle '{}': its {} instance is no longer alive", it->second,
+                input == VehicleInput::kRequest ? kRequestTopic : kProgressTopic);
+  registry_.on_instance_gone(it->second, input);
+  names.erase(it);
 }
 
 void PulloutService::handle_request(const msg::PullOutRequest& sample) {

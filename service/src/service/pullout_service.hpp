@@ -14,12 +14,14 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <unordered_map>
 
+#include <fastdds/rtps/common/InstanceHandle.h>
 #include <fastdds/dds/core/condition/GuardCondition.hpp>
 
 #include "pullout/config/config.hpp"
@@ -27,6 +29,10 @@
 #include "service/dds_edge.hpp"
 #include "service/planning_queue.hpp"
 #include "service/vehicle_registry.hpp"
+
+namespace eprosima::fastdds::dds {
+struct SampleInfo;
+}  // namespace eprosima::fastdds::dds
 
 namespace pullout::msg {
 class PullOutRequest;
@@ -62,6 +68,11 @@ class PulloutService {
   // Whether the sample's writer may speak for vehicle_id (DdsEdge::sender_may_act_for); logs a
   // refusal, rate-limited.
   bool sender_allowed(const eprosima::fastdds::dds::SampleInfo& info, const std::string& vehicle_id, const char* what);
+  // Which vehicle each instance of a reader belongs to: a sample telling that an instance is no
+  // longer alive carries no key fields. An entry lives as long as the reader's instance (erased
+  // when it is reported gone), so max_instances bounds the map.
+  using InstanceNames = std::map<eprosima::fastrtps::rtps::InstanceHandle_t, std::string>;
+  void instance_gone(InstanceNames& names, const eprosima::fastdds::dds::SampleInfo& info, VehicleInput input);
   void handle_request(const msg::PullOutRequest& sample);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
@@ -80,6 +91,9 @@ class PulloutService {
   // Dispatcher thread only: samples refused because their writer may not speak for their vehicle.
   std::uint64_t refused_samples_{0};
   std::chrono::steady_clock::time_point refused_logged_{};
+  // Dispatcher thread only.
+  InstanceNames request_instances_;
+  InstanceNames progress_instances_;
   // Last: destroyed (workers joined) before the registry and the DDS entities they use.
   std::unique_ptr<PlanningQueue> queue_;
 };

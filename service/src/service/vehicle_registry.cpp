@@ -13,8 +13,39 @@ std::int64_t now_ns() {
       .count();
 }
 
-VehicleRegistry::VehicleRegistry(const StartPlanner& planner, Outbox& outbox, SessionOptions options)
-    : planner_(planner), outbox_(outbox), options_(options) {}
+namespace {
+
+double seconds(VehicleSession::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// Driving a path: the vehicle may be moving on what the session checks.
+bool driving(const PullOutStatus& s) { return s.departed && s.state != ExecutionState::kCompleted; }
+
+}  // namespace
+
+const char* to_string(EvictionReason reason) {
+  switch (reason) {
+    case EvictionReason::kGone:
+      return "its request and progress writers are gone";
+    case EvictionReason::kIdle:
+      return "idle timeout";
+    case EvictionReason::kCapacity:
+      return "room for a new vehicle (service.max_vehicles)";
+  }
+  return "?";
+}
+
+VehicleRegistry::VehicleRegistry(const StartPlanner& planner, Outbox& outbox, RegistryOptions options)
+    : planner_(planner), outbox_(outbox), options_(std::move(options)) {
+  if (!options_.clock) options_.clock = [] { return Clock::now(); };
+  if (options_.max_vehicles < 1) options_.max_vehicles = 1;
+}
+
+std::size_t VehicleRegistry::size() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return vehicles_.size();
+}
+
+bool VehicleRegistry::holds(const std::string& vehicle_id) const { return find(vehicle_id) != nullptr; }
 
 std::shared_ptr<VehicleRegistry::Slot> VehicleRegistry::find(const std::string& vehicle_id) const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -22,11 +53,120 @@ std::shared_ptr<VehicleRegistry::Slot> VehicleRegistry::find(const std::string& 
   return it == vehicles_.end() ? nullptr : it->second;
 }
 
-std::shared_ptr<VehicleRegistry::Slot> VehicleRegistry::find_or_add(const std::string& vehicle_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto& slot = vehicles_[vehicle_id];
-  if (!slot) slot = std::make_shared<Slot>(vehicle_id, planner_, options_);
+std::optional<EvictionReason> VehicleRegistry::eviction_reason(const Slot& slot, Clock::time_point now,
+                                                               bool for_capacity) const {
+  const VehicleSession& session = slot.session;
+  if (session.pending_search() != 0) return std::nullopt;
+  const bool gone = !slot.request_alive && !slot.progress_alive;
+  const double timeout = options_.session_idle_timeout_s;
+  const bool timed_out = timeout > 0.0 && seconds(now - session.last_input()) >= timeout;
+  if (driving(session.status())) {
+    // Never while the vehicle may be driving and reporting: only when it is gone and silent.
+    if (gone && timed_out) return EvictionReason::kGone;
+    return std::nullopt;
+  }
+  if (gone) return EvictionReason::kGone;
+  if (timed_out) return EvictionReason::kIdle;
+  if (for_capacity) return EvictionReason::kCapacity;
+  return std::nullopt;
+}
+
+std::shared_ptr<VehicleRegistry::Slot> VehicleRegistry::find_or_admit(const std::string& vehicle_id,
+                                                                      Clock::time_point now) {
+  std::shared_ptr<Slot> victim;
+  std::string victim_id;
+  EvictionReason reason = EvictionReason::kCapacity;
+  std::shared_ptr<Slot> slot;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = vehicles_.find(vehicle_id);
+    if (it != vehicles_.end()) return it->second;
+    if (vehicles_.size() >= options_.max_vehicles) {
+      // The least recently active idle session, one whose vehicle is gone first. A session whose
+      // lock is taken is busy (a worker publishes for it): not a candidate. O(max_vehicles), only
+      // when full.
+      Clock::time_point best_input{};
+      bool best_gone = false;
+      for (const auto& [id, candidate] : vehicles_) {
+        std::unique_lock<std::mutex> candidate_lock(candidate->mutex, std::try_to_lock);
+        if (!candidate_lock.owns_lock()) continue;
+        const auto why = eviction_reason(*candidate, now, true);
+        if (!why) continue;
+        const bool gone = *why == EvictionReason::kGone;
+        const Clock::time_point input = candidate->session.last_input();
+        if (!victim || (gone && !best_gone) || (gone == best_gone && input < best_input)) {
+          victim = candidate;
+          victim_id = id;
+          reason = *why;
+          best_input = input;
+          best_gone = gone;
+        }
+      }
+      if (!victim) return nullptr;
+      {
+        std::lock_guard<std::mutex> victim_lock(victim->mutex);
+        // Still idle (only the dispatcher makes a session busy, and it is here), now out of service.
+        victim->evicted = true;
+      }
+      vehicles_.erase(victim_id);
+    }
+    slot = std::make_shared<Slot>(vehicle_id, planner_, options_.session);
+    vehicles_.emplace(vehicle_id, slot);
+  }
+  if (victim) forget(*victim, victim_id, reason, now);
   return slot;
+}
+
+void VehicleRegistry::forget(Slot& slot, const std::string& vehicle_id, EvictionReason reason, Clock::time_point now) {
+  PullOutStatus last;
+  Clock::time_point last_input;
+  {
+    std::lock_guard<std::mutex> lock(slot.mutex);
+    last = slot.session.status();
+    last_input = slot.session.last_input();
+  }
+  {
+    // After any sample of this vehicle still being written (a result handed over to the publish
+    // lock just before the eviction): an unregister before it would be undone by the write.
+    std::lock_guard<std::mutex> publishing(slot.publish_mutex);
+    outbox_.forget_vehicle(vehicle_id);
+  }
+  evicted_count_.fetch_add(1);
+  spdlog::info("vehicle '{}' evicted: {}; idle {:.1f} s, last request {} in state {}", vehicle_id, to_string(reason),
+               seconds(now - last_input), last.request_id, pullout::to_string(last.state));
+}
+
+void VehicleRegistry::reject_full(const PullOutRequest& request) {
+  const std::string reason = "service.max_vehicles: the service holds " + std::to_string(options_.max_vehicles) +
+                             " vehicle sessions and none is idle (planning or driving); request not served, send it "
+                             "again later";
+  PullOutPath path;
+  path.vehicle_id = request.vehicle_id;
+  path.request_id = request.request_id;
+  path.found = false;
+  path.reasons = {reason};
+  path.stamp_ns = now_ns();
+  PullOutStatus status;
+  status.vehicle_id = request.vehicle_id;
+  status.request_id = request.request_id;
+  status.state = ExecutionState::kRejected;
+  status.error = reason;
+  status.stamp_ns = now_ns();
+  outbox_.publish_path(path);
+  outbox_.publish_status(status);
+  // Written at once (synchronous publication); the instances must not stay for a vehicle that has
+  // no session.
+  outbox_.forget_vehicle(request.vehicle_id);
+  rejected_full_count_.fetch_add(1);
+  // One line per second at most: a flood of new ids must not flood the log.
+  const auto now = Clock::now();
+  ++full_since_log_;
+  if (now - last_full_log_ >= std::chrono::seconds(1)) {
+    spdlog::warn("vehicle '{}' request {} rejected: {} ({} such rejection(s) since the last line)", request.vehicle_id,
+                 request.request_id, reason, full_since_log_);
+    last_full_log_ = now;
+    full_since_log_ = 0;
+  }
 }
 
 std::optional<PlanningJob> VehicleRegistry::settle(Slot& slot, std::unique_lock<std::mutex>& lock,
@@ -76,9 +216,16 @@ std::optional<PlanningJob> VehicleRegistry::on_request(PullOutRequest request,
                                                        const std::vector<RequestIssue>& conversion_issues) {
   const std::string vehicle_id = request.vehicle_id;
   const std::uint64_t request_id = request.request_id;
-  const auto slot = find_or_add(vehicle_id);
+  const auto now = options_.clock();
+  const auto slot = find_or_admit(vehicle_id, now);
+  if (!slot) {
+    reject_full(request);
+    return std::nullopt;
+  }
   std::unique_lock<std::mutex> lock(slot->mutex);
-  SessionEffects effects = slot->session.on_request(std::move(request), conversion_issues, Clock::now());
+  if (slot->evicted) return std::nullopt;  // not for the dispatcher's own slot; defensive
+  slot->request_alive = true;
+  SessionEffects effects = slot->session.on_request(std::move(request), conversion_issues, now);
   if (effects.status && effects.status->state == ExecutionState::kRejected) {
     spdlog::warn("vehicle '{}' request {}: {}", vehicle_id, request_id, effects.note);
     effects.note.clear();
@@ -93,7 +240,8 @@ void VehicleRegistry::on_result(const PlanningJob& job, const PlanningResult& re
   const auto slot = find(job.request.vehicle_id);
   if (!slot) return;
   std::unique_lock<std::mutex> lock(slot->mutex);
-  SessionEffects effects = slot->session.on_result(job.sequence, result, Clock::now());
+  if (slot->evicted) return;
+  SessionEffects effects = slot->session.on_result(job.sequence, result, options_.clock());
   if (effects.empty()) {
     spdlog::debug("vehicle '{}' request {}: result dropped, a newer request arrived", job.request.vehicle_id,
                   job.request.request_id);
@@ -107,7 +255,8 @@ void VehicleRegistry::on_search_failed(const PlanningJob& job, const std::string
   const auto slot = find(job.request.vehicle_id);
   if (!slot) return;
   std::unique_lock<std::mutex> lock(slot->mutex);
-  settle(*slot, lock, slot->session.on_search_failed(job.sequence, what, Clock::now()), job.request.vehicle_id);
+  if (slot->evicted) return;
+  settle(*slot, lock, slot->session.on_search_failed(job.sequence, what, options_.clock()), job.request.vehicle_id);
 }
 
 void VehicleRegistry::on_progress(const ExecutionProgress& progress) {
@@ -117,7 +266,9 @@ void VehicleRegistry::on_progress(const ExecutionProgress& progress) {
     return;
   }
   std::unique_lock<std::mutex> lock(slot->mutex);
-  SessionEffects effects = slot->session.on_progress(progress, Clock::now());
+  if (slot->evicted) return;
+  slot->progress_alive = true;
+  SessionEffects effects = slot->session.on_progress(progress, options_.clock());
   if (effects.status) {
     const PullOutStatus& s = *effects.status;
     spdlog::info("vehicle '{}' request {}: {} segment {}/{}{}{}", progress.vehicle_id, s.request_id, to_string(s.state),
@@ -132,14 +283,41 @@ void VehicleRegistry::on_time() {
     std::lock_guard<std::mutex> lock(mutex_);
     slots.assign(vehicles_.begin(), vehicles_.end());
   }
-  const auto now = Clock::now();
-  for (auto& [id, slot] : slots) {
+  const auto now = options_.clock();
+  std::vector<std::pair<std::size_t, EvictionReason>> evict;  // index into slots
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    auto& [id, slot] = slots[i];
     std::unique_lock<std::mutex> lock(slot->mutex);
+    if (slot->evicted) continue;
     SessionEffects effects = slot->session.on_time(now);
     if (effects.status)
       spdlog::warn("vehicle '{}' request {}: {}", id, effects.status->request_id, effects.status->stop_reason);
-    settle(*slot, lock, std::move(effects), id);
+    if (!effects.empty()) {
+      settle(*slot, lock, std::move(effects), id);
+      continue;  // it just published: not now
+    }
+    if (evict.size() >= kMaxEvictionsPerSweep) continue;
+    if (const auto why = eviction_reason(*slot, now, false)) {
+      slot->evicted = true;
+      evict.emplace_back(i, *why);
+    }
   }
+  if (evict.empty()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [i, why] : evict) {
+      const auto it = vehicles_.find(slots[i].first);
+      if (it != vehicles_.end() && it->second == slots[i].second) vehicles_.erase(it);
+    }
+  }
+  for (const auto& [i, why] : evict) forget(*slots[i].second, slots[i].first, why, now);
+}
+
+void VehicleRegistry::on_instance_gone(const std::string& vehicle_id, VehicleInput input) {
+  const auto slot = find(vehicle_id);
+  if (!slot) return;
+  std::lock_guard<std::mutex> lock(slot->mutex);
+  (input == VehicleInput::kRequest ? slot->request_alive : slot->progress_alive) = false;
 }
 
 void VehicleRegistry::cancel_all() {

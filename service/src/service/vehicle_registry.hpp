@@ -10,11 +10,28 @@
 //
 // The registry also owns each vehicle's cancellation flag: a session's cancel_search sets the
 // flag of the running search, and a search order gets a fresh one.
+//
+// Eviction (the registry holds at most options.max_vehicles sessions over a lifetime of any number
+// of vehicle ids). A session is idle when no search of it is awaited and it is not driving a path
+// (departed and not completed). It is evicted
+//   - kGone:     idle, and its vehicle's request and progress instances are no longer alive on the
+//                service's readers (on_instance_gone: unregistered, disposed, or no writer left);
+//                a vehicle driving a path only once it was also silent for the idle timeout;
+//   - kIdle:     idle, and no request and no progress for session_idle_timeout_s;
+//   - kCapacity: when a new vehicle comes and max_vehicles sessions are held: the least recently
+//                active idle session (one of kGone first). When none is idle, the new vehicle
+//                gets a kRejected path and status naming service.max_vehicles, and no session.
+// on_time() sweeps for kGone and kIdle (at most kMaxEvictionsPerSweep per call). Eviction removes
+// the session and calls Outbox::forget_vehicle (unregisters the vehicle's path and status
+// instances) after any of its samples in flight; each is logged with the reason and idle time.
+// A departed vehicle that still sends progress is never idle, so never evicted.
 #pragma once
 
 #include <atomic>
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -33,12 +50,32 @@ namespace pullout::service {
 // Nanoseconds since the epoch, for the stamps of outgoing samples.
 std::int64_t now_ns();
 
+// How many evictions one on_time() sweep does at most (each is two unregister writes); the rest
+// wait for the next sweep.
+inline constexpr std::size_t kMaxEvictionsPerSweep = 256;
+
+struct RegistryOptions {
+  SessionOptions session;
+  // [s] See the eviction rules above; 0 = no kIdle eviction.
+  double session_idle_timeout_s{300.0};
+  // Sessions held at once (>= 1).
+  std::size_t max_vehicles{2048};
+  // The registry's time (sessions, idle times); tests inject a fake. Empty: steady_clock::now.
+  std::function<VehicleSession::Clock::time_point()> clock;
+};
+
+// The reader a vehicle's instance lived on.
+enum class VehicleInput { kRequest, kProgress };
+
+enum class EvictionReason { kGone, kIdle, kCapacity };
+const char* to_string(EvictionReason reason);
+
 class VehicleRegistry {
  public:
   using Clock = VehicleSession::Clock;
 
   // `planner` validates requests and configures the sessions; it must outlive the registry.
-  VehicleRegistry(const StartPlanner& planner, Outbox& outbox, SessionOptions options = {});
+  VehicleRegistry(const StartPlanner& planner, Outbox& outbox, RegistryOptions options = {});
 
   // A request; `conversion_issues` are the problems found while decoding it. Returns the search
   // to queue, if the session ordered one.
@@ -49,8 +86,18 @@ class VehicleRegistry {
   void on_search_failed(const PlanningJob& job, const std::string& what);
   // One odometry sample (decoded without problems).
   void on_progress(const ExecutionProgress& progress);
-  // Time passes: every session's on_time (the odometry watchdog).
+  // The vehicle's instance on that reader is no longer alive (unregistered, disposed, or no writer
+  // left). A later valid sample makes it alive again. Unknown vehicles are ignored.
+  void on_instance_gone(const std::string& vehicle_id, VehicleInput input);
+  // Time passes: every session's on_time (the odometry watchdog), then the eviction sweep.
   void on_time();
+
+  // Sessions held, and whether one is held for `vehicle_id` (for tests and statistics).
+  std::size_t size() const;
+  bool holds(const std::string& vehicle_id) const;
+  // Sessions evicted so far, by any reason, and new vehicles rejected because the registry was full.
+  std::size_t evicted_count() const { return evicted_count_.load(); }
+  std::size_t rejected_full_count() const { return rejected_full_count_.load(); }
 
   // Cancels every running search (shutdown).
   void cancel_all();
@@ -62,10 +109,24 @@ class VehicleRegistry {
     std::mutex publish_mutex;  // held while this vehicle's effects are written
     VehicleSession session;
     std::shared_ptr<std::atomic<bool>> cancel;  // of the running search
+    // Whether the vehicle's instance is alive on the request / progress reader (guarded by mutex).
+    bool request_alive{false};
+    bool progress_alive{false};
+    bool evicted{false};  // removed from the map: publishes nothing more (guarded by mutex)
   };
 
   std::shared_ptr<Slot> find(const std::string& vehicle_id) const;
-  std::shared_ptr<Slot> find_or_add(const std::string& vehicle_id);
+  // The vehicle's slot; a new one if there is room or an idle session can be evicted for it;
+  // null when the registry is full of sessions that are not idle.
+  std::shared_ptr<Slot> find_or_admit(const std::string& vehicle_id, Clock::time_point now);
+  // Why `slot` should go now (caller holds slot.mutex); nullopt: it stays. `for_capacity`: also
+  // any idle session (kCapacity).
+  std::optional<EvictionReason> eviction_reason(const Slot& slot, Clock::time_point now, bool for_capacity) const;
+  // Unregisters the vehicle's instances after its samples in flight, and logs. The slot is
+  // already marked evicted and out of the map.
+  void forget(Slot& slot, const std::string& vehicle_id, EvictionReason reason, Clock::time_point now);
+  // A new vehicle while the registry is full: kRejected path and status, instances unregistered.
+  void reject_full(const PullOutRequest& request);
   // Applies cancel/search effects (caller holds slot.mutex), then hands the lock over to the
   // publish lock and writes path and status. Returns the job for a search order.
   std::optional<PlanningJob> settle(Slot& slot, std::unique_lock<std::mutex>& lock, SessionEffects effects,
@@ -73,9 +134,13 @@ class VehicleRegistry {
 
   const StartPlanner& planner_;
   Outbox& outbox_;
-  SessionOptions options_;
+  RegistryOptions options_;
   mutable std::mutex mutex_;  // guards vehicles_ (the map, not the sessions)
   std::unordered_map<std::string, std::shared_ptr<Slot>> vehicles_;
+  std::atomic<std::size_t> evicted_count_{0};
+  std::atomic<std::size_t> rejected_full_count_{0};
+  Clock::time_point last_full_log_{};  // rate limit of reject_full's log line (dispatcher only)
+  std::size_t full_since_log_{0};
 };
 
 }  // namespace pullout::service

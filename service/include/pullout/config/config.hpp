@@ -14,6 +14,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -54,6 +55,12 @@ struct ServiceConfig {
   std::string log_level{"info"};  // one of kLogLevels
   // [s] A departed vehicle with no progress sample for this long is told to stop (0: never).
   double progress_timeout_s{2.0};
+  // [s] A session with no request and no progress for this long, no search running and not
+  // driving a path (departed and not completed), is evicted (0: never by time).
+  double session_idle_timeout_s{300.0};
+  // Sessions held at once; when full, the least recently active idle one makes room, and when
+  // none is idle a new vehicle is rejected. At most the DDS profiles' max_instances.
+  std::size_t max_vehicles{2048};
 };
 
 struct MapConfig {

@@ -48,6 +48,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -123,6 +124,15 @@ class VehicleSession {
   std::uint64_t pending_search() const { return pending_; }
   // When the session last received anything from its vehicle.
   Clock::time_point last_input() const { return last_input_; }
+  // What the session keeps of its vehicle's requests: the objects of the request whose search
+  // is awaited (the safety check keeps its own copy once a path is found), and the points of the
+  // followed and published paths. Zero objects once no search is awaited; zero points unless a
+  // found path is followed: a rejected request, a no-path or a failed search keeps nothing.
+  struct Retained {
+    std::size_t objects{0};
+    std::size_t path_points{0};
+  };
+  Retained retained() const;
 
  private:
   // No path is followed any more: tracker, safety monitor, stop and progress reference forgotten.
