@@ -124,7 +124,9 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--case") == 0) cases = {argv[i + 1]};
     if (std::strcmp(argv[i], "--deadline-ms") == 0) deadline_ms = std::atof(argv[i + 1]);
   }
-  std::printf("| case | outcome | planning [ms] | wall [s] | CPU [s] | peak RSS [MB] | detail |\n|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| case | outcome | planning [ms] | wall [s] | CPU [s] | peak RSS [MB] | detail "
+      "|\n|---|---|---|---|---|---|---|\n");
   for (const std::string& name : cases) {
     int fds[2];
     if (pipe(fds) != 0) return 1;
