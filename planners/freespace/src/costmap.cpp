@@ -53,6 +53,15 @@ int clamped_int(double v, int lo, int hi) {
 // The largest side of a costmap made by from_polygons [cells].
 constexpr int kMaxSideCells = 1 << 14;
 
+// Rows or columns between two checks of the stop condition (a row is at most 16384 cells).
+constexpr int kStopCheckRows = 64;
+
+bool stop_now(const StopCondition& stop, int line, StopReason& stopped) {
+  if (line % kStopCheckRows != 0) return false;
+  stopped = stop.check();
+  return stopped != StopReason::kNone;
+}
+
 }  // namespace
 
 bool strip_extent(const Vec2* vertices, std::size_t count, double y0, double y1, double& x_min, double& x_max) {
@@ -76,7 +85,14 @@ bool strip_extent(const Vec2* vertices, std::size_t count, double y0, double y1,
   return x_min <= x_max;
 }
 
-Costmap::Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied)
+Costmap::Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied,
+                 const StopCondition& stop)
+    : Costmap(origin, resolution, width, height, std::move(occupied), kDeferred) {
+  precompute(stop);
+}
+
+Costmap::Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied,
+                 Deferred /*unused*/)
     : origin_(origin),
       resolution_(resolution),
       cos_(std::cos(origin.yaw)),
@@ -85,30 +101,42 @@ Costmap::Costmap(const Pose2& origin, double resolution, int width, int height, 
       height_(std::max(0, height)),
       occupied_(std::move(occupied)) {
   occupied_.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), 0);
-  precompute();
 }
 
-Costmap Costmap::from_occupancy_grid(const OccupancyGrid& grid, int obstacle_threshold) {
+Costmap Costmap::from_occupancy_grid(const OccupancyGrid& grid, int obstacle_threshold, const StopCondition& stop) {
+  if (const StopReason reason = stop.check(); reason != StopReason::kNone) {  // before allocating anything
+    Costmap map(grid.origin, grid.resolution_m, 0, 0, {}, kDeferred);
+    map.stopped_ = reason;
+    return map;
+  }
   std::vector<std::uint8_t> occ(grid.data.size());
   for (std::size_t i = 0; i < grid.data.size(); ++i) {
     occ[i] = (grid.data[i] < 0 || grid.data[i] >= obstacle_threshold) ? 1 : 0;
   }
   return Costmap(grid.origin, grid.resolution_m, static_cast<int>(grid.width), static_cast<int>(grid.height),
-                 std::move(occ));
+                 std::move(occ), stop);
 }
 
 Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std::vector<Polygon>& drivable,
                                const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
-                               const std::vector<Polygon>& obstacles) {
+                               const std::vector<Polygon>& obstacles, const StopCondition& stop) {
   const int w = clamped_int(std::ceil((extent.max.x() - extent.min.x()) / resolution), 1, kMaxSideCells);
   const int h = clamped_int(std::ceil((extent.max.y() - extent.min.y()) / resolution), 1, kMaxSideCells);
   const Pose2 origin{extent.min.x(), extent.min.y(), 0.0};
+  StopReason stopped = StopReason::kNone;
+  const auto stopped_map = [&]() {
+    Costmap map(origin, resolution, 0, 0, {}, kDeferred);
+    map.stopped_ = stopped;
+    return map;
+  };
+  if ((stopped = stop.check()) != StopReason::kNone) return stopped_map();  // before allocating anything
   std::vector<std::uint8_t> occ(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 1);
 
   // Cells whose centre lies inside some drivable polygon (even-odd rule per polygon, the union
   // over polygons), found by one crossing list per row at the cell centres' height.
   std::vector<std::vector<double>> crossings(static_cast<std::size_t>(h));
   for (const Polygon& poly : drivable) {
+    if ((stopped = stop.check()) != StopReason::kNone) return stopped_map();
     for (auto& row : crossings) row.clear();
     for (std::size_t i = 0; i < poly.size(); ++i) {
       const Vec2 a = (poly[i] - extent.min) / resolution;
@@ -125,6 +153,7 @@ Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std:
       }
     }
     for (int j = 0; j < h; ++j) {
+      if (stop_now(stop, j, stopped)) return stopped_map();
       auto& xs = crossings[static_cast<std::size_t>(j)];
       std::sort(xs.begin(), xs.end());
       for (std::size_t k = 0; k + 1 < xs.size(); k += 2) {
@@ -135,20 +164,26 @@ Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std:
       }
     }
   }
-  Costmap map(origin, resolution, w, h, std::move(occ));
+  Costmap map(origin, resolution, w, h, std::move(occ), kDeferred);
   // The outline cuts through the cells it touches: those are not entirely drivable.
   std::vector<Polygon> blocked;
   blocked.reserve(drivable_outline.size() + obstacles.size());
   for (const auto& [a, b] : drivable_outline) blocked.push_back({a, b});
   blocked.insert(blocked.end(), obstacles.begin(), obstacles.end());
-  map.add_obstacles(blocked);
+  if (map.mark(blocked, stop)) map.precompute(stop);
   return map;
 }
 
-void Costmap::add_obstacles(const std::vector<Polygon>& polygons) {
+void Costmap::add_obstacles(const std::vector<Polygon>& polygons, const StopCondition& stop) {
+  if (mark(polygons, stop)) precompute(stop);
+}
+
+bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& stop) {
   std::vector<Vec2> g;
+  std::size_t count = 0;
   for (const Polygon& poly : polygons) {
     if (poly.empty()) continue;
+    if (stop_now(stop, static_cast<int>(count++ % kStopCheckRows), stopped_)) return false;
     g.clear();
     double y_lo = std::numeric_limits<double>::infinity();
     double y_hi = -y_lo;
@@ -171,7 +206,7 @@ void Costmap::add_obstacles(const std::vector<Polygon>& polygons) {
       for (int i = i0; i <= i1; ++i) occupied_[index(i, j)] = 1;
     }
   }
-  precompute();
+  return true;
 }
 
 Vec2 Costmap::to_grid(const Vec2& p) const {
@@ -216,10 +251,11 @@ long long Costmap::occupied_in_box(int c0, int r0, int c1, int r1) const {
   return area - inside + occupied_in_box_inside(ic0, ir0, ic1, ir1);
 }
 
-void Costmap::precompute() {
+void Costmap::precompute(const StopCondition& stop) {
   const std::size_t stride = static_cast<std::size_t>(width_) + 1;
   box_prefix_.assign(stride * (static_cast<std::size_t>(height_) + 1), 0);
   for (int j = 0; j < height_; ++j) {
+    if (stop_now(stop, j, stopped_)) return;
     const std::int32_t* below = box_prefix_.data() + static_cast<std::size_t>(j) * stride;
     std::int32_t* box = box_prefix_.data() + static_cast<std::size_t>(j + 1) * stride;
     std::int32_t row = 0;  // occupied cells of row j left of column i + 1
@@ -244,12 +280,14 @@ void Costmap::precompute() {
   std::vector<double> z(n + 1);
   std::vector<int> v(n);
   for (int i = 0; i < pw; ++i) {  // columns
+    if (stop_now(stop, i, stopped_)) return;
     for (int j = 0; j < ph; ++j) in[j] = f[static_cast<std::size_t>(j) * pw + i];
     distance_transform_1d(in.data(), ph, out.data(), v.data(), z.data());
     for (int j = 0; j < ph; ++j) f[static_cast<std::size_t>(j) * pw + i] = out[j];
   }
   distance_.assign(static_cast<std::size_t>(width_) * height_, 0.0F);
   for (int j = 1; j <= height_; ++j) {  // rows (the padding rows are not needed any more)
+    if (stop_now(stop, j, stopped_)) return;
     distance_transform_1d(&f[static_cast<std::size_t>(j) * pw], pw, out.data(), v.data(), z.data());
     for (int i = 1; i <= width_; ++i) {
       distance_[index(i - 1, j - 1)] = static_cast<float>(std::sqrt(out[i]) * resolution_);

@@ -61,15 +61,20 @@ HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const Free
   return c;
 }
 
+double freespace_window_half_size(const FreespaceParameters& p, const VehicleInfo& vehicle) {
+  return p.end_pose_search_end_distance + vehicle.length_m() + kWindowExtra;
+}
+
 Footprint freespace_footprint(const VehicleInfo& vehicle, const FreespaceParameters& p) {
   return vehicle_footprint(vehicle, 0.5 * p.vehicle_shape_margin);
 }
 
 Costmap freespace_costmap(const FreespaceParameters& p, const OccupancyGrid* grid, const LaneWorld* world,
-                          const std::vector<Polygon>& obstacles, const Pose2& centre, double half_window) {
+                          const std::vector<Polygon>& obstacles, const Pose2& centre, double half_window,
+                          const StopCondition& stop) {
   if (grid != nullptr) {
-    Costmap map = Costmap::from_occupancy_grid(*grid, p.costmap_configs.obstacle_threshold);
-    if (!obstacles.empty()) map.add_obstacles(obstacles);
+    Costmap map = Costmap::from_occupancy_grid(*grid, p.costmap_configs.obstacle_threshold, stop);
+    if (!obstacles.empty() && map.stopped() == StopReason::kNone) map.add_obstacles(obstacles, stop);
     return map;
   }
   Aabb lanes_box;
@@ -83,7 +88,7 @@ Costmap freespace_costmap(const FreespaceParameters& p, const OccupancyGrid* gri
   extent.min = lanes_box.min.cwiseMax(Vec2{centre.x - half_window, centre.y - half_window});
   extent.max = lanes_box.max.cwiseMin(Vec2{centre.x + half_window, centre.y + half_window});
   extent = extent.inflated(p.costmap_configs.resolution);  // a blocked rim around the lanes
-  return Costmap::from_polygons(extent, p.costmap_configs.resolution, drivable, world->outer_edges(), obstacles);
+  return Costmap::from_polygons(extent, p.costmap_configs.resolution, drivable, world->outer_edges(), obstacles, stop);
 }
 
 SplitPath split_at_cusps(const std::vector<Waypoint>& w, double velocity) {
@@ -144,9 +149,11 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
   if (out.stopped != StopReason::kNone) return out;  // before the costmap, the heaviest set-up
   const std::vector<Polygon> no_obstacles;
   const std::vector<Polygon>& obstacles = ctx.obstacle_polygons != nullptr ? *ctx.obstacle_polygons : no_obstacles;
-  const double half_window = p.end_pose_search_end_distance + ctx.vehicle.length_m() + kWindowExtra;
-  // The costmap and the search are shared by every end pose; heavy, so built once.
-  const Costmap costmap = freespace_costmap(p, ctx.occupancy_grid, &ctx.world, obstacles, ctx.ego, half_window);
+  const double half_window = freespace_window_half_size(p, ctx.vehicle);
+  // The costmap and the search are shared by every end pose; heavy, so built once, within `until`.
+  const Costmap costmap = freespace_costmap(p, ctx.occupancy_grid, &ctx.world, obstacles, ctx.ego, half_window, until);
+  out.stopped = costmap.stopped();
+  if (out.stopped != StopReason::kNone) return out;
   const GridCollisionChecker checker(costmap, freespace_footprint(ctx.vehicle, p));
   const HybridAStar search(checker, freespace_search_config(ctx.vehicle, p));
 

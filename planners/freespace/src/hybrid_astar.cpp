@@ -57,6 +57,7 @@ class Search {
 
   HybridAStarResult run(const StopCondition& stop) {
     HybridAStarResult result;
+    heuristic_.watch(stop);
     double start_clearance = 0.0;
     if (checker_.collides(start_, start_clearance)) {
       result.status = HybridAStarResult::Status::kStartOccupied;
@@ -77,6 +78,10 @@ class Search {
       if (result.expansions % kStopCheckInterval == 0) {
         result.stopped = stop.check();
         if (result.stopped != StopReason::kNone) break;
+      }
+      if (heuristic_.stopped() != StopReason::kNone) {  // it stopped inside a flood of the grid
+        result.stopped = heuristic_.stopped();
+        break;
       }
       const auto [f, index] = open_.top();
       open_.pop();
@@ -108,6 +113,8 @@ class Search {
       expand(index);
     }
     result.nodes = nodes_.size();
+    // A heuristic stopped inside a flood answers nothing useful: what followed is no verdict.
+    if (result.stopped == StopReason::kNone && finish.node < 0) result.stopped = heuristic_.stopped();
     if (finish.node < 0) {
       result.status = result.stopped == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
                       : result.stopped != StopReason::kNone    ? HybridAStarResult::Status::kTimeout

@@ -146,7 +146,12 @@ float ObstacleHeuristic::settle(std::int32_t c) {
   const float diagonal = static_cast<float>(cell_size_ * std::sqrt(2.0));
   constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  constexpr std::size_t kStopCheckInterval = 1024;
   while (!open_.empty() && open_.top().first < distance_[static_cast<std::size_t>(c)]) {
+    if (stopped_ != StopReason::kNone) break;
+    if (stop_ != nullptr && ++settled_ % kStopCheckInterval == 0 && (stopped_ = stop_->check()) != StopReason::kNone) {
+      break;
+    }
     const auto [d, idx] = open_.top();
     open_.pop();
     if (d > distance_[static_cast<std::size_t>(idx)]) continue;

@@ -88,9 +88,18 @@ struct ObstacleHeuristicConfig {
 // final, and a cell's passability and rate are worked out when the search first reaches it, so
 // the cost follows the part of the map the hybrid A* explores, not the map's size. Not thread
 // safe (distance() advances the search); one per plan.
+//
+// One distance() may have to flood the whole grid (a pose the goal cannot be reached from): with
+// watch(stop), that flood checks the stop condition every 1024 cells it settles, and once it says
+// stop, stopped() is set and every distance() returns at once (a value of no use: the hybrid A*
+// ends its search on stopped()).
 class ObstacleHeuristic {
  public:
   ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal);
+
+  // The stop condition to honour inside distance(); must outlive this object.
+  void watch(const StopCondition& stop) { stop_ = &stop; }
+  StopReason stopped() const { return stopped_; }
 
   // Distance [m] from p (map frame) to the goal; +inf when the goal cannot be reached from p.
   double distance(const Pose2& p);
@@ -111,6 +120,9 @@ class ObstacleHeuristic {
   std::vector<float> rate_;  // NaN until computed
   using Item = std::pair<float, std::int32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open_;
+  const StopCondition* stop_{nullptr};
+  StopReason stopped_{StopReason::kNone};
+  std::size_t settled_{0};  // cells taken off the open list, for the stop checks
 };
 
 // Open-addressing map from a lattice key to a node index.

@@ -12,6 +12,7 @@
 #include "pullout/lane_planners/clothoid_pull_out.hpp"
 #include "pullout/lane_planners/geometric_pull_out.hpp"
 #include "pullout/lane_planners/shift_pull_out.hpp"
+#include "pullout/lanes/lane_crop.hpp"
 #include "pullout/lanes/lane_world.hpp"
 #include "pullout/maps/lanelet_map.hpp"
 #include "pullout/maps/map_lanes.hpp"
@@ -28,34 +29,109 @@ constexpr double kBackwardPathLength = 5.0;
 // [m] A route passing farther than this from the start is not the one to pull out onto.
 constexpr double kMaxRouteDistance = 10.0;
 
-// The lanes one request plans on: its inline lanes, or those picked on the map for its route
-// (with the road and pull-out lanes in driving order).
+// [m] Added to the farthest reach of the planners and checks: the lateral offset of the vehicle
+// from the road centerline, lane widths, and the footprint's reach beyond a path point.
+constexpr double kHorizonSlack = 50.0;
+
+// The lanes one request plans on: its inline lanes, or those picked on the map for its route (with
+// the road and pull-out lanes in driving order), cropped to the planning horizon.
 struct RequestLanes {
-  std::vector<Lane> from_map;
-  const std::vector<Lane>* lanes{nullptr};
+  std::vector<Lane> lanes;
   std::vector<std::int64_t> road_ids;      // map requests: the road lanes
   std::vector<std::int64_t> pull_out_ids;  // map requests: the shoulder lanes (empty: the road)
   std::vector<RequestIssue> issues;
 };
 
+std::string format_length(double m) {
+  std::ostringstream os;
+  os << m;
+  return os.str();
+}
+
+double bounds_length(const std::vector<Lane>& lanes) {
+  double total = 0.0;
+  for (const Lane& lane : lanes) total += polyline_length(lane.left_bound) + polyline_length(lane.right_bound);
+  return total;
+}
+
+// Distance [m] from p to the outline of a lane (its bounds and their end joints).
+double distance_to_lane(const Lane& lane, const Vec2& p) {
+  Polygon ring;
+  for (const Point2& q : lane.left_bound) ring.push_back(to_vec(q));
+  for (auto it = lane.right_bound.rbegin(); it != lane.right_bound.rend(); ++it) ring.push_back(to_vec(*it));
+  double d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < ring.size(); ++i)
+    d = std::min(d, distance_to_segment(p, ring[i], ring[(i + 1) % ring.size()]));
+  return d;
+}
+
+// Of `ids` (driving order), those whose lane the crop kept, cut to the run of consecutive kept ones
+// holding the lane nearest to `ego`: a chain that leaves the horizon and comes back is not joined
+// across the gap.
+std::vector<std::int64_t> kept_run(const std::vector<std::int64_t>& ids, const std::vector<Lane>& kept,
+                                   const Vec2& ego) {
+  const auto lane_of = [&](std::int64_t id) -> const Lane* {
+    for (const Lane& l : kept) {
+      if (l.id == id) return &l;
+    }
+    return nullptr;
+  };
+  std::size_t nearest = ids.size();
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const Lane* l = lane_of(ids[i]);
+    if (l == nullptr) continue;
+    const double d = distance_to_lane(*l, ego);
+    if (d < best) {
+      best = d;
+      nearest = i;
+    }
+  }
+  if (nearest == ids.size()) return {};
+  std::size_t first = nearest;
+  while (first > 0 && lane_of(ids[first - 1]) != nullptr) --first;
+  std::size_t last = nearest;
+  while (last + 1 < ids.size() && lane_of(ids[last + 1]) != nullptr) ++last;
+  return {ids.begin() + static_cast<std::ptrdiff_t>(first), ids.begin() + static_cast<std::ptrdiff_t>(last) + 1};
+}
+
 RequestLanes request_lanes(const PullOutRequest& request, const LaneletMap* map, const VehicleInfo& vehicle,
-                           const StartPlannerParameters& params) {
+                           const StartPlannerParameters& params, const RequestLimits& limits) {
   RequestLanes out;
-  if (request.route_lanelet_ids.empty() || map == nullptr) {
-    out.lanes = &request.lanes;
+  const bool from_map = !request.route_lanelet_ids.empty() && map != nullptr;
+  MapLanes selected;
+  if (from_map) {
+    MapLaneOptions options;
+    options.backward_length_m = kBackwardPathLength + params.max_back_distance;
+    options.forward_length_m = params.forward_path_length;
+    options.start_tolerance_m = vehicle.width_m() / 2.0;
+    options.max_route_distance_m = kMaxRouteDistance;
+    selected = select_map_lanes(*map, request, options);
+    if (!selected.issues.empty()) {
+      out.issues = std::move(selected.issues);
+      return out;
+    }
+  }
+  const std::vector<Lane>& all = from_map ? selected.lanes : request.lanes;
+  const double horizon = planning_horizon_m(params, vehicle);
+  CroppedLanes cropped = crop_lanes(all, horizon_square(request.ego_pose.x, request.ego_pose.y, horizon));
+  const std::string field = from_map ? "route_lanelet_ids" : "lanes";
+  const std::string where = " within the planning horizon (" + format_length(horizon) + " m around ego_pose)";
+  const double kept_length = bounds_length(cropped.lanes);
+  if (kept_length > limits.max_horizon_lane_length_m) {
+    out.issues.push_back({field, format_length(kept_length) + " m of lane bounds" + where + " exceed the limit of " +
+                                     format_length(limits.max_horizon_lane_length_m) + " m"});
     return out;
   }
-  MapLaneOptions options;
-  options.backward_length_m = kBackwardPathLength + params.max_back_distance;
-  options.forward_length_m = params.forward_path_length;
-  options.start_tolerance_m = vehicle.width_m() / 2.0;
-  options.max_route_distance_m = kMaxRouteDistance;
-  MapLanes selected = select_map_lanes(*map, request, options);
-  out.issues = std::move(selected.issues);
-  out.from_map = std::move(selected.lanes);
-  out.lanes = &out.from_map;
-  out.road_ids = std::move(selected.road_ids);
-  out.pull_out_ids = std::move(selected.pull_out_ids);
+  out.lanes = std::move(cropped.lanes);
+  if (from_map) {
+    out.road_ids = kept_run(selected.road_ids, out.lanes, to_vec(request.ego_pose));
+    out.pull_out_ids = kept_run(selected.pull_out_ids, out.lanes, to_vec(request.ego_pose));
+    if (out.road_ids.empty()) out.issues.push_back({field, "no road lanelet of the route" + where});
+  } else if (std::none_of(out.lanes.begin(), out.lanes.end(),
+                          [](const Lane& l) { return l.subtype == LaneSubtype::kRoad; })) {
+    out.issues.push_back({field, "no lane of subtype road" + where});
+  }
   return out;
 }
 
@@ -183,13 +259,29 @@ StartPlanner::StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameter
                            std::shared_ptr<const LaneletMap> map)
     : vehicle_(vehicle), parameters_(std::move(parameters)), limits_(limits), map_(std::move(map)) {}
 
+double planning_horizon_m(const StartPlannerParameters& p, const VehicleInfo& vehicle) {
+  const TargetFilteringParameters& f = p.path_safety_check.target_filtering;
+  // Ahead: a path runs forward_path_length beyond its start, and beyond the freespace end pose;
+  // the safety check looks object_check_forward_distance ahead of the vehicle on it.
+  const double ahead = p.forward_path_length + std::max(0.0, p.freespace_planner.end_pose_search_end_distance) +
+                       f.object_check_forward_distance;
+  // Behind: the reverse to a start candidate, the road kept behind it, and the safety check's look back.
+  const double behind = p.max_back_distance + kBackwardPathLength + f.object_check_backward_distance;
+  // The freespace costmap's square window, to its corner.
+  const double window = std::sqrt(2.0) * freespace_window_half_size(p.freespace_planner, vehicle);
+  double margin = 0.0;
+  for (double m : p.collision_check_margins) margin = std::max(margin, m);
+  return std::max({ahead, behind, window, p.surround_moving_obstacle_check.search_radius}) + vehicle.length_m() +
+         margin + kHorizonSlack;
+}
+
 std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) const {
   auto issues =
       validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
   if (!issues.empty() || (request.lanes.empty() && request.route_lanelet_ids.empty())) return issues;
-  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_);
+  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_, limits_);
   if (!lanes.issues.empty()) return lanes.issues;
-  const LaneWorld world(*lanes.lanes);
+  const LaneWorld world(lanes.lanes);
   if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) issues.push_back(*issue);
   return issues;
 }
@@ -205,8 +297,18 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
     if (!parameters_.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
     obstacles.push_back(object_polygon(o));
   }
-  const Costmap costmap = freespace_costmap(p, &*request.occupancy_grid, nullptr, obstacles, request.ego_pose, 0.0);
-  FreespaceGoalResult r = plan_freespace_to_goal(costmap, vehicle_, p, request.ego_pose, request.goal_pose, stop);
+  // The costmap is built within the search's own budget too (a grid of max_grid_cells is the
+  // costliest set-up there is).
+  const Costmap costmap = freespace_costmap(p, &*request.occupancy_grid, nullptr, obstacles, request.ego_pose, 0.0,
+                                            stop.with_budget_ms(p.time_limit));
+  FreespaceGoalResult r;
+  if (costmap.stopped() != StopReason::kNone) {
+    r.stopped = costmap.stopped();
+    r.status = r.stopped == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
+                                                   : HybridAStarResult::Status::kTimeout;
+  } else {
+    r = plan_freespace_to_goal(costmap, vehicle_, p, request.ego_pose, request.goal_pose, stop);
+  }
   const double margin = 0.5 * p.vehicle_shape_margin;
   const Failure f =
       r.stopped != StopReason::kNone ? stopped_failure(r.stopped) : Failure{attempt_outcome(r.status), "to the goal"};
@@ -241,6 +343,18 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     r.path.request_id = request.request_id;
     r.path.stamp_ns = request.stamp_ns;
   };
+  // The caller's stop condition ended a build step before any attempt: no path, nothing planned.
+  const auto stopped_early = [&](PlanningResult& r, StopReason reason) -> PlanningResult& {
+    r.outcome = PlanningResult::Outcome::kNoPath;
+    r.stopped = reason;
+    r.timed_out = reason == StopReason::kDeadline;
+    r.path = make_stop_path(request);
+    r.stop_reason =
+        std::string(r.timed_out ? "planning deadline exceeded" : "planning cancelled") + " while building the lanes";
+    r.path.reasons.push_back(r.stop_reason);
+    finish(r);
+    return r;
+  };
 
   result.issues =
       validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
@@ -254,15 +368,16 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     finish(result);
     return result;
   }
-  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_);
+  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_, limits_);
   if (!lanes.issues.empty()) {
     result.issues = lanes.issues;
     result.outcome = PlanningResult::Outcome::kRejected;
     finish(result);
     return result;
   }
-  planned_lanes = lanes.lanes;
-  const LaneWorld world(*lanes.lanes);
+  planned_lanes = &lanes.lanes;
+  const LaneWorld world(lanes.lanes, stop);
+  if (world.stopped() != StopReason::kNone) return stopped_early(result, world.stopped());
   if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) {
     result.issues.push_back(*issue);
     result.outcome = PlanningResult::Outcome::kRejected;
@@ -284,9 +399,12 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   // Static obstacles: objects slower than th_moving_object_velocity, of the classes to check.
   // All of them are considered, wherever they stand (Autoware keeps only those overlapping the
   // pull-out lanes, which misses a car standing half on the kerb next to the path).
+  // Only those that may reach into the planning horizon: no path or check comes near the others.
+  const Aabb near_square = horizon_square(request.ego_pose.x, request.ego_pose.y, planning_horizon_m(params, vehicle_));
   std::vector<Obstacle> obstacles;
   std::vector<Polygon> obstacle_polygons;
   for (const Object& o : request.objects) {
+    if (!object_near(o, near_square)) continue;
     if (std::abs(o.velocity_mps) >= params.th_moving_object_velocity) continue;
     if (!params.object_types_to_check_for_path_generation.includes(o.object_class)) continue;
     obstacles.push_back({o.id, object_polygon(o)});

@@ -28,9 +28,22 @@ class Checker {
     add(field, std::string("not a finite number (") + (std::isnan(v) ? "NaN" : "infinite") + ")");
     return false;
   }
+  // A finite coordinate within max_coordinate_m of the origin.
+  bool coordinate(const std::string& field, const char* axis, double v) {
+    if (!finite(field + "." + axis, v)) return false;
+    return within_extent(field + "." + axis, std::string("|") + axis + "|", v);
+  }
+  // |v| <= max_coordinate_m (a length or a coordinate); `what` names it in the message.
+  bool within_extent(const std::string& field, const std::string& what, double v) {
+    if (std::abs(v) <= limits_.max_coordinate_m) return true;
+    std::ostringstream os;
+    os << what << " " << std::abs(v) << " exceeds " << limits_.max_coordinate_m << " m";
+    add(field, os.str());
+    return false;
+  }
   bool pose(const std::string& field, const Pose2& p) {
-    bool ok = finite(field + ".x", p.x);
-    ok = finite(field + ".y", p.y) && ok;
+    bool ok = coordinate(field, "x", p.x);
+    ok = coordinate(field, "y", p.y) && ok;
     return finite(field + ".yaw", p.yaw) && ok;
   }
   bool points(const std::string& field, const std::vector<Point2>& pts) {
@@ -45,6 +58,7 @@ class Checker {
         add(f, "not a finite point");
         return false;  // one report per line is enough
       }
+      if (!within_extent(f + ".x", "|x|", pts[i].x) || !within_extent(f + ".y", "|y|", pts[i].y)) return false;
     }
     return true;
   }
@@ -105,6 +119,8 @@ void validate_object(Checker& c, const std::string& f, const Object& o, const Re
   if (o.polygon.empty()) {
     if (c.finite(f + ".length_m", o.length_m) && o.length_m <= 0.0) c.add(f + ".length_m", "must be positive");
     if (c.finite(f + ".width_m", o.width_m) && o.width_m <= 0.0) c.add(f + ".width_m", "must be positive");
+    if (std::isfinite(o.length_m)) c.within_extent(f + ".length_m", "length", o.length_m);
+    if (std::isfinite(o.width_m)) c.within_extent(f + ".width_m", "width", o.width_m);
   } else if (c.count(f + ".polygon", o.polygon.size(), limits.max_polygon_points, "points")) {
     if (o.polygon.size() < 3) {
       c.add(f + ".polygon", "needs at least 3 points, has " + std::to_string(o.polygon.size()));

@@ -399,6 +399,11 @@ const Table<RequestLimits>& limits_table() {
       // Ten minutes: anything longer is a typo.
       field("max_deadline_ms", &T::max_deadline_ms, "ms", in_open_closed(0.0, 600000.0),
             "cap of a request's deadline_ms"),
+      // Beyond 1e9 m, distances lose centimetres to rounding.
+      field("max_coordinate_m", &T::max_coordinate_m, "m", in_open_closed(0.0, 1e9),
+            "|x|, |y| of every point and pose, object lengths and widths"),
+      field("max_horizon_lane_length_m", &T::max_horizon_lane_length_m, "m", above(0.0),
+            "lane bounds kept within the planning horizon, all lanes"),
   }};
   return t;
 }

@@ -33,11 +33,13 @@ std::vector<Vec2> to_vecs(const std::vector<Point2>& pts) {
 
 constexpr std::size_t kPieceVertices = 16;  // bound vertices per lane piece (each side)
 
-// Vertices of `line` strictly between arc lengths s0 and s1, in order.
-void append_between(const Polyline& line, double s0, double s1, Polygon& out) {
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    if (line.s(i) > s0 + 1e-9 && line.s(i) < s1 - 1e-9) out.push_back(line.point(i));
-  }
+// Appends the vertices of `line` strictly between arc lengths s0 and s1, in order, starting the
+// scan at `next` (the first vertex not yet passed) and leaving it at the first vertex at or beyond
+// s1: consecutive pieces share one walk along the line, so cutting costs O(vertices), not
+// O(pieces x vertices).
+void append_between(const Polyline& line, double s0, double s1, std::size_t& next, Polygon& out) {
+  while (next < line.size() && line.s(next) <= s0 + 1e-9) ++next;
+  while (next < line.size() && line.s(next) < s1 - 1e-9) out.push_back(line.point(next++));
 }
 
 // The lane polygon cut into pieces at common normalised arc lengths of both bounds.
@@ -45,14 +47,16 @@ std::vector<Polygon> cut_into_pieces(const Polyline& left, const Polyline& right
   const std::size_t n = std::max<std::size_t>(1, std::max(left.size(), right.size()) / kPieceVertices);
   std::vector<Polygon> pieces;
   pieces.reserve(n);
+  std::size_t next_left = 0;
+  std::size_t next_right = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double t0 = static_cast<double>(k) / static_cast<double>(n);
     const double t1 = static_cast<double>(k + 1) / static_cast<double>(n);
     Polygon piece{left.point_at(t0 * left.length())};
-    append_between(left, t0 * left.length(), t1 * left.length(), piece);
+    append_between(left, t0 * left.length(), t1 * left.length(), next_left, piece);
     piece.push_back(left.point_at(t1 * left.length()));
     Polygon right_part{right.point_at(t0 * right.length())};
-    append_between(right, t0 * right.length(), t1 * right.length(), right_part);
+    append_between(right, t0 * right.length(), t1 * right.length(), next_right, right_part);
     right_part.push_back(right.point_at(t1 * right.length()));
     piece.insert(piece.end(), right_part.rbegin(), right_part.rend());
     pieces.push_back(std::move(piece));
@@ -60,13 +64,18 @@ std::vector<Polygon> cut_into_pieces(const Polyline& left, const Polyline& right
   return pieces;
 }
 
-// Midline of two bounds, matched by normalised arc length.
-Polyline derive_centerline(const Polyline& left, const Polyline& right) {
+// Work items (centerline samples, edge pieces) between two checks of the stop condition.
+constexpr std::size_t kStopCheckInterval = 1024;
+
+// Midline of two bounds, matched by normalised arc length. Empty when `stop` says stop first.
+Polyline derive_centerline(const Polyline& left, const Polyline& right, const StopCondition& stop,
+                           StopReason& stopped) {
   const double len = std::max(left.length(), right.length());
   const std::size_t n = piece_count(len, kCenterlineStep) + 1;
   std::vector<Vec2> pts;
   pts.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
+    if (i % kStopCheckInterval == 0 && (stopped = stop.check()) != StopReason::kNone) return Polyline();
     const double t = static_cast<double>(i) / static_cast<double>(n - 1);
     pts.push_back(0.5 * (left.point_at(t * left.length()) + right.point_at(t * right.length())));
   }
@@ -81,25 +90,29 @@ std::size_t LaneChain::lane_at(double s) const {
   return static_cast<std::size_t>(std::distance(lane_end_s.begin(), it));
 }
 
-LaneWorld::LaneWorld(const std::vector<Lane>& lanes) {
+LaneWorld::LaneWorld(const std::vector<Lane>& lanes, const StopCondition& stop) {
   lanes_.reserve(lanes.size());
   for (const Lane& in : lanes) {
+    if ((stopped_ = stop.check()) != StopReason::kNone) return;
     LaneGeometry g;
     g.id = in.id;
     g.subtype = in.subtype;
     g.left = Polyline(to_vecs(in.left_bound));
     g.right = Polyline(to_vecs(in.right_bound));
-    g.centerline = in.centerline.size() >= 2 ? Polyline(to_vecs(in.centerline)) : derive_centerline(g.left, g.right);
+    g.centerline = in.centerline.size() >= 2 ? Polyline(to_vecs(in.centerline))
+                                             : derive_centerline(g.left, g.right, stop, stopped_);
+    if (stopped_ != StopReason::kNone) return;
     g.polygon = g.left.points();
     g.polygon.insert(g.polygon.end(), g.right.points().rbegin(), g.right.points().rend());
     g.box = bounding_box(g.polygon);
     g.pieces = cut_into_pieces(g.left, g.right);
     for (const Polygon& piece : g.pieces) g.piece_boxes.push_back(bounding_box(piece));
     g.speed_limit_mps = in.speed_limit_mps;
+    work_ += g.centerline.size();
     lanes_.push_back(std::move(g));
   }
   build_topology();
-  build_index();
+  build_index(stop);
 }
 
 std::optional<std::size_t> LaneWorld::find(std::int64_t id) const {
@@ -124,7 +137,7 @@ void LaneWorld::build_topology() {
   }
 }
 
-void LaneWorld::build_index() {
+void LaneWorld::build_index(const StopCondition& stop) {
   for (std::size_t i = 0; i < lanes_.size(); ++i) {
     for (std::size_t k = 0; k < lanes_[i].pieces.size(); ++k) {
       piece_index_.insert(lanes_[i].piece_boxes[k], {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
@@ -150,6 +163,7 @@ void LaneWorld::build_index() {
       // departure test sees few long segments.
       std::optional<Vec2> run_start;
       for (std::size_t p = 0; p < pieces; ++p) {
+        if (++work_ % kStopCheckInterval == 0 && (stopped_ = stop.check()) != StopReason::kNone) return;
         const Vec2 pa = a + dir * (len * static_cast<double>(p) / static_cast<double>(pieces));
         const Vec2 pb = a + dir * (len * static_cast<double>(p + 1) / static_cast<double>(pieces));
         const Vec2 probe = 0.5 * (pa + pb) + kSharedEdgeProbe * outward;

@@ -173,6 +173,12 @@ class Loader {
                   "' is not a number");
           continue;
         }
+        if (std::abs(*v) > kMaxMapCoordinateM) {
+          std::ostringstream os;
+          os << "node " << *id << where(n) << ": " << k << " " << *v << " exceeds " << kMaxMapCoordinateM << " m";
+          problem(os.str());
+          continue;
+        }
         (k == "local_x" ? x : y) = v;
       }
       if (x && y) {
@@ -228,6 +234,13 @@ class Loader {
       double y = 0.0;
       double z = 0.0;
       projection.Forward(node.lat, node.lon, 0.0, x, y, z);
+      if (std::abs(x) > kMaxMapCoordinateM || std::abs(y) > kMaxMapCoordinateM) {
+        std::ostringstream os;
+        os << "node " << id << ": lat/lon projects to (" << x << ", " << y << ") m, beyond " << kMaxMapCoordinateM
+           << " m of the first node";
+        problem(os.str());
+        continue;
+      }
       node.xy = {x, y};
     }
   }

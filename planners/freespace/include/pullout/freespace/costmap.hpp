@@ -16,6 +16,12 @@
 //
 // The distance transform is exact for cell centres (Felzenszwalb & Huttenlocher, "Distance
 // Transforms of Sampled Functions", Theory of Computing 8, 2012).
+//
+// Building costs O(cells) (up to 16384 x 16384 from polygons, max_grid_cells from a grid) and
+// honours a stop condition: it is checked before every drivable polygon, every 64 rows of the
+// rasterisation, every 64 obstacle polygons, and every 64 rows or columns of the summed-area table
+// and the distance transform. A build it cuts short returns at once with stopped() set; such a
+// costmap is incomplete and must not be searched.
 #pragma once
 
 #include <cstdint>
@@ -23,6 +29,7 @@
 
 #include "pullout/geometry/polygon.hpp"
 #include "pullout/model/types.hpp"
+#include "pullout/search/stop_condition.hpp"
 
 namespace pullout {
 
@@ -30,10 +37,11 @@ class Costmap {
  public:
   Costmap() = default;
   // `occupied` is row-major (width x height), non-zero = obstacle. resolution > 0 [m].
-  Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied);
+  Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied,
+          const StopCondition& stop = {});
 
   // From a ROS occupancy grid: unknown (< 0) or >= obstacle_threshold is an obstacle.
-  static Costmap from_occupancy_grid(const OccupancyGrid& grid, int obstacle_threshold);
+  static Costmap from_occupancy_grid(const OccupancyGrid& grid, int obstacle_threshold, const StopCondition& stop = {});
   // An axis-aligned grid over `extent` (map frame) at `resolution`: free where a cell lies inside
   // the union of `drivable` polygons (simple polygons, any orientation) and touches no `obstacles`
   // polygon. `drivable_outline` lists the edges of the union's outline (edges shared by two lanes
@@ -41,12 +49,15 @@ class Costmap {
   // at its max corner (what is cut off lies outside the grid, so counts as occupied).
   static Costmap from_polygons(const Aabb& extent, double resolution, const std::vector<Polygon>& drivable,
                                const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
-                               const std::vector<Polygon>& obstacles);
+                               const std::vector<Polygon>& obstacles, const StopCondition& stop = {});
 
   // Marks every cell whose interior a polygon (map frame) meets as occupied (conservative;
   // non-convex polygons are filled row by row between their extreme points; a segment marks the
   // cells it passes through). Updates the precomputation.
-  void add_obstacles(const std::vector<Polygon>& polygons);
+  void add_obstacles(const std::vector<Polygon>& polygons, const StopCondition& stop = {});
+
+  // Why the last build step was cut short (see the file comment); kNone when complete.
+  StopReason stopped() const { return stopped_; }
 
   bool empty() const { return width_ == 0 || height_ == 0; }
   int width() const { return width_; }
@@ -93,7 +104,11 @@ class Costmap {
   std::size_t index(int ix, int iy) const {
     return static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(ix);
   }
-  void precompute();
+  enum Deferred { kDeferred };  // tag: the cells are set, the precomputation is left to the caller
+  Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied, Deferred);
+  // Marks the polygons' cells (add_obstacles without the precomputation); false when stopped.
+  bool mark(const std::vector<Polygon>& polygons, const StopCondition& stop);
+  void precompute(const StopCondition& stop);
 
   Pose2 origin_;
   double resolution_{0.2};
@@ -106,6 +121,7 @@ class Costmap {
   // Summed-area table, (width + 1) x (height + 1): occupied cells in columns < c and rows < r (a
   // row's count is the difference of two neighbouring table rows).
   std::vector<std::int32_t> box_prefix_;
+  StopReason stopped_{StopReason::kNone};
 };
 
 // The column extent of a convex polygon (grid frame, cell units) within the horizontal strip

@@ -51,11 +51,17 @@ HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const Free
 // The vehicle footprint grown by vehicle_shape_margin (half on each side).
 Footprint freespace_footprint(const VehicleInfo& vehicle, const FreespaceParameters& parameters);
 
+// [m] Half the side of the costmap's square window around the vehicle: the farthest end pose,
+// the vehicle's length and 10 m more.
+double freespace_window_half_size(const FreespaceParameters& parameters, const VehicleInfo& vehicle);
+
 // The costmap of a request: the grid with the obstacles added, or (grid == nullptr) the lanes of
 // `world` and the obstacles over the square window of half size `half_window` [m] around
-// `centre`, clipped to the lanes' bounding box.
+// `centre`, clipped to the lanes' bounding box. Built within `stop` (Costmap::stopped() tells
+// whether it cut the build short: such a costmap is not to be searched).
 Costmap freespace_costmap(const FreespaceParameters& parameters, const OccupancyGrid* grid, const LaneWorld* world,
-                          const std::vector<Polygon>& obstacles, const Pose2& centre, double half_window);
+                          const std::vector<Polygon>& obstacles, const Pose2& centre, double half_window,
+                          const StopCondition& stop = {});
 
 // Waypoints -> partial paths split at every change of direction: velocity direction x velocity,
 // 0 on the last point of each partial path; one pair per partial path ({+/-v, +/-v^2 / L}: v

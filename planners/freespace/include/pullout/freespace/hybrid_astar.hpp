@@ -35,8 +35,9 @@
 // samples, and a motion is refused only if it passes within an eighth of a cell of an obstacle.
 //
 // Failure modes are values (Status), never exceptions. The stop condition is checked before the
-// first expansion and every few expansions after it; the search returns kTimeout (deadline or
-// budget) or kCancelled promptly once it says stop. More than max_nodes nodes give kNodeLimit.
+// first expansion and every few expansions after it, and inside the obstacle heuristic's flood of
+// the grid (every 1024 cells); the search returns kTimeout (deadline or budget) or kCancelled
+// promptly once it says stop. More than max_nodes nodes give kNodeLimit.
 //
 // Thread safety: plan() is const and may run concurrently (all search state is local).
 #pragma once

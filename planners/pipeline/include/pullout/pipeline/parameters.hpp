@@ -61,7 +61,13 @@ struct ParameterIssue {
 std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p);
 
 // Limits on the size of a request, so that one vehicle cannot make the service allocate or compute
-// without bound. Defaults are generous for real use.
+// without bound. Defaults are generous for real use. A request beyond any of them is rejected, the
+// field named ("lanes[0].left_bound[1].x: |x| 1e+20 exceeds 1e+07 m").
+//
+// Work that grows with the lanes' length is bounded by cropping them to the planning horizon
+// (planning_horizon_m, start_planner.hpp) before anything is built; what the crop keeps is then
+// bounded by max_horizon_lane_length_m, and coordinates by max_coordinate_m (so that distances
+// and the crop's bisection stay well within double precision).
 struct RequestLimits {
   std::size_t max_lanes{256};
   std::size_t max_points_per_line{10000};  // points in one bound or centerline
@@ -72,6 +78,13 @@ struct RequestLimits {
   std::size_t max_route_lanelets{1000};
   std::size_t max_grid_cells{std::size_t{16} * 1024 * 1024};
   double max_deadline_ms{10000.0};
+  // [m] |x| and |y| of every point and pose (lanes, ego, goal, objects and their polygons and
+  // predicted paths, the grid origin), and object lengths and widths. 1e7 m: the size of a UTM zone.
+  double max_coordinate_m{1e7};
+  // [m] Total length of the lanes' bounds (left + right, every lane) inside the planning horizon,
+  // after the crop. A straight lane crossing the horizon keeps about 2 x 2 x 400 m; the default
+  // admits several hundred of those, and bounds the zig-zag lanes no crop can shorten.
+  double max_horizon_lane_length_m{500000.0};
 };
 
 }  // namespace pullout

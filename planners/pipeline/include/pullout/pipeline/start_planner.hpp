@@ -19,6 +19,15 @@
 // request.route_lanelet_ids then names the road lanelets to pull out onto, and the pipeline plans
 // on the lanes select_map_lanes (maps/map_lanes.hpp) picks around the vehicle. A request with
 // route ids and no map, or with both lanes and route ids, is rejected.
+//
+// Bounded work: whatever the coordinates, the lanes (inline or from the map) are cropped to the
+// planning horizon (planning_horizon_m, a square around the ego pose; lanes/lane_crop.hpp) and the
+// static objects to those that may reach into it, before the lane world is built. What the crop
+// keeps is bounded by RequestLimits (max_horizon_lane_length_m; max_coordinate_m for every
+// coordinate). Every build step that grows with the input (lane world, costmap, heuristic) checks
+// the stop condition inside, so a deadline or cancellation is honoured before the first attempt.
+// A request whose road lies beyond the horizon is rejected ("lanes: no lane of subtype road within
+// the planning horizon (...)").
 #pragma once
 
 #include <memory>
@@ -65,6 +74,17 @@ struct PlanningResult {
   // kFound and kNoPath: what was planned on (lanes empty for a grid-only request). Null: kRejected.
   std::shared_ptr<const PlannedWorld> world;
 };
+
+// [m] Half the side of the square around the ego pose that a plan with these parameters can reach:
+// the largest of (forward_path_length + freespace_planner.end_pose_search_end_distance +
+// path_safety_check.target_filtering.object_check_forward_distance: the path ahead and the safety
+// check's look ahead of the vehicle on it), (max_back_distance + 5 m of road kept behind +
+// object_check_backward_distance: the reverse and the look back), the freespace costmap window to
+// its corner, and surround_moving_obstacle_check.search_radius; plus the vehicle's length, the
+// largest collision margin and 50 m for the lateral offset to the road. About 397 m with the
+// defaults. A path never leaves this square (its arc length is bounded), so cropping to it changes
+// no plan.
+double planning_horizon_m(const StartPlannerParameters& parameters, const VehicleInfo& vehicle);
 
 class StartPlanner {
  public:

@@ -5,6 +5,11 @@
 // within 0.1 m). Lanes are expected to be valid (see StartPlanner::validate): at least two points
 // per bound and a polygon with non-zero area. Derived centerlines are sampled every 0.5 m, and
 // edges cut into 0.5 m pieces, up to 1e5 per line (longer lines get longer steps).
+//
+// Cost: the building work grows with the lanes' length (samples and edge pieces every 0.5 m), so
+// the pipeline crops the lanes to the planning horizon first (lane_crop.hpp) and hands a stop
+// condition in: it is checked before every lane and every 1024 samples or edge pieces, and a build
+// it stops returns at once with stopped() set. A stopped world is incomplete: plan nothing on it.
 #pragma once
 
 #include <array>
@@ -16,6 +21,7 @@
 #include "pullout/geometry/polygon.hpp"
 #include "pullout/geometry/polyline.hpp"
 #include "pullout/model/types.hpp"
+#include "pullout/search/stop_condition.hpp"
 
 namespace pullout {
 
@@ -49,7 +55,13 @@ struct LaneChain {
 
 class LaneWorld {
  public:
-  explicit LaneWorld(const std::vector<Lane>& lanes);
+  explicit LaneWorld(const std::vector<Lane>& lanes, const StopCondition& stop = {});
+
+  // Why the build was cut short (see the file comment); kNone when the world is complete.
+  StopReason stopped() const { return stopped_; }
+  // Units of work the build did: centerline points and edge pieces examined. A measure of its
+  // memory and time that does not depend on the clock (for tests and benchmarks).
+  std::size_t build_work() const { return work_; }
 
   const std::vector<LaneGeometry>& lanes() const { return lanes_; }
   std::optional<std::size_t> find(std::int64_t id) const;
@@ -77,10 +89,12 @@ class LaneWorld {
 
  private:
   void build_topology();
-  void build_index();
+  void build_index(const StopCondition& stop);
   bool inside_other_lane(const Vec2& p, std::size_t lane) const;
 
   std::vector<LaneGeometry> lanes_;
+  StopReason stopped_{StopReason::kNone};
+  std::size_t work_{0};
   // Pieces of lane edges that are not shared with a neighbouring lane: the outline of the union.
   std::vector<std::pair<Vec2, Vec2>> outer_edges_;
   static constexpr double kCellSize = 4.0;  // [m] cells of the indexes

@@ -18,7 +18,13 @@
 // Failure modes: MapLoadError (never a crash) for an unreadable file, XML that does not parse
 // (with the line), and for each lanelet that cannot be built: a missing or doubled bound, a bound
 // referring to a way or node that is not in the file, a bound of fewer than 2 distinct points, a
-// malformed number or tag value; also duplicate ids and a file with no lanelet at all.
+// malformed number or tag value; also duplicate ids and a file with no lanelet at all; and a node
+// farther than kMaxMapCoordinateM from the origin (local_x / local_y, or lat/lon projected).
+//
+// Size: loading is linear in the file (the spatial index files a lanelet covering more than 4096
+// cells of 16 m in a list of its own, see grid_index.hpp), and a lanelet of any length is planned
+// on in bounded work: the pipeline crops it to the planning horizon (lanes/lane_crop.hpp). A
+// 1,000 km lanelet loads and plans like a 100 m one.
 #pragma once
 
 #include <memory>
@@ -29,6 +35,10 @@
 #include "pullout/maps/lanelet_map.hpp"
 
 namespace pullout {
+
+// [m] |x| and |y| of every node in the map frame: the request limit of the same name
+// (RequestLimits::max_coordinate_m), so that what the map yields is what a request may carry.
+constexpr double kMaxMapCoordinateM = 1e7;
 
 // what() is one line: "<source>: <first problem>" plus "(and N more problems)" when there are
 // more; problems() lists them all.
