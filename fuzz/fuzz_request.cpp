@@ -109,8 +109,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const pullout::PlanningResult result =
       f.planner.plan(accepted.search->request, pullout::StopCondition::after_ms(kDeadlineMs));
   if (f.verbose) {
-    std::cerr << "fuzz_request: " << (result.outcome == pullout::PlanningResult::Outcome::kFound ? "found" : "not found")
-              << " (" << pullout::to_string(result.path.planner_type) << ") in " << result.planning_time_ms
+    std::cerr << "fuzz_request: "
+              << (result.outcome == pullout::PlanningResult::Outcome::kFound ? "found" : "not found") << " ("
+              << pullout::to_string(result.path.planner_type) << ") in " << result.planning_time_ms
               << " ms: " << result.stop_reason << pullout::format_issues(result.issues) << "\n";
   }
   publish_effects(f, session.on_result(accepted.search->sequence, result, std::chrono::steady_clock::now()));

@@ -28,10 +28,10 @@ struct Fixture {
     dir = pattern;
     fs::create_directories(dir / "scenarios");
     fs::create_directory_symlink(fs::path(PULLOUT_SOURCE_DIR) / "tests" / "maps", dir / "maps");
-    std::ofstream(dir / "scenarios" / "lot.pgm", std::ios::binary) << "P5\n4 3\n255\n"
-                                                                   << std::string("\x00\xff\xff\xff", 4)
-                                                                   << std::string("\xff\x80\xff\xff", 4)
-                                                                   << std::string("\xff\xff\xff\x00", 4);
+    std::ofstream(dir / "scenarios" / "lot.pgm", std::ios::binary)
+        << "P5\n4 3\n255\n"
+        << std::string("\x00\xff\xff\xff", 4) << std::string("\xff\x80\xff\xff", 4)
+        << std::string("\xff\xff\xff\x00", 4);
     std::ofstream(dir / "scenarios" / "lot.yaml") << "image: lot.pgm\nresolution: 0.5\norigin: [1.0, 2.0, 0.0]\n"
                                                   << "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n";
     input = (dir / "scenarios" / "input.yaml").string();

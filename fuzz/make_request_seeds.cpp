@@ -161,9 +161,9 @@ void write_bad_requests(const fs::path& dir) {
     cdr.serialize_encapsulation();
     cdr << std::string("bad-sequence-length") << std::uint64_t{1} << std::int32_t{0} << std::uint32_t{0};
     for (double v : {10.0, 3.25, 0.0, 0.0, 0.0, 0.0, 1.0}) cdr << v;  // ego pose
-    cdr << 0.0;                                                         // ego velocity
-    for (double v : {90.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0}) cdr << v;  // goal pose
-    cdr << std::uint32_t{0x7fffffff};                                   // lanes
+    cdr << 0.0;                                                       // ego velocity
+    for (double v : {90.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0}) cdr << v;   // goal pose
+    cdr << std::uint32_t{0x7fffffff};                                 // lanes
     write(dir / "bad_sequence_length.cdr", std::string(buffer.data(), cdr.getSerializedDataLength()));
   }
   {  // the first 100 bytes of a valid request
