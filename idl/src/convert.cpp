@@ -336,7 +336,7 @@ msg::PullOutRequest to_msg(const PullOutRequest& in) {
   for (const auto& object : in.objects) out.objects().push_back(object_to_msg(object));
   out.occupancy_grid(grid_to_msg(in.occupancy_grid));
   for (const auto planner : in.overrides.search_priority) {
-    out.overrides().search_priority().push_back(enum_to_msg<PlannerType, msg::PlannerType>(planner));
+    out.overrides().search_priority().push_back(static_cast<std::uint32_t>(planner));
   }
   if (!in.overrides.search_policy) {
     out.overrides().search_policy(msg::POLICY_DEFAULT);
@@ -372,7 +372,8 @@ PullOutRequest from_msg(const msg::PullOutRequest& in, std::vector<RequestIssue>
   const auto& priority = in.overrides().search_priority();
   out.overrides.search_priority.reserve(priority.size());
   for (std::size_t i = 0; i < priority.size(); ++i) {
-    out.overrides.search_priority.push_back(checked_enum(priority[i], msg::PLANNER_FREESPACE, PlannerType::kNone,
+    out.overrides.search_priority.push_back(checked_enum(static_cast<msg::PlannerType>(priority[i]),
+                                                         msg::PLANNER_FREESPACE, PlannerType::kNone,
                                                          indexed("overrides.search_priority", i), sink));
   }
   switch (in.overrides().search_policy()) {

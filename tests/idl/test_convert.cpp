@@ -223,7 +223,7 @@ TEST(Convert, UnknownEnumeratorsAreIssues) {
   msg::PullOutRequest m = to_msg(sample_request());
   m.lanes()[0].subtype(static_cast<msg::LaneSubtype>(9));
   m.objects()[0].classification(static_cast<msg::ObjectClass>(42));
-  m.overrides().search_priority()[1] = static_cast<msg::PlannerType>(77);
+  m.overrides().search_priority()[1] = 77;
   m.overrides().search_policy(static_cast<msg::SearchPolicy>(3));
   std::vector<RequestIssue> issues;
   from_msg(m, issues);

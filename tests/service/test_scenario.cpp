@@ -323,6 +323,22 @@ TEST(Scenario, GridFromAMapServerImage) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Scenario, GridFilesThatAreDirectoriesAreProblems) {
+  // `grid: {map: }` names the scenario's own directory, and an image may name a directory too:
+  // reading one threw std::ios_failure out of load_scenario (found by fuzz_scenario).
+  const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_dir_map_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "images");
+  std::ofstream(dir / "scenario.yaml") << kPoses << "grid: {map: }\n";
+  auto p = problems_of_file((dir / "scenario.yaml").string());
+  EXPECT_TRUE(any_starts_with(p, "grid.map: ")) << dump(p);
+
+  std::ofstream(dir / "lot.yaml") << "image: images\nresolution: 0.5\norigin: [1.0, 2.0, 0.0]\n";
+  std::ofstream(dir / "scenario.yaml") << kPoses << "grid: {map: lot.yaml}\n";
+  p = problems_of_file((dir / "scenario.yaml").string());
+  EXPECT_TRUE(any_starts_with(p, (dir / "images").string() + ": cannot read file")) << dump(p);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Scenario, UnreadableFile) {
   try {
     load_scenario("/nonexistent/scenario.yaml");

@@ -47,7 +47,9 @@ bool parse_int(const std::string& s, long& v) {
 
 bool read_pgm(const std::string& file, PgmImage& out, std::vector<std::string>& problems) {
   std::ifstream in(file, std::ios::binary);
-  if (!in) {
+  // A directory opens, and reading it throws std::ios_failure.
+  std::error_code ec;
+  if (!in || !std::filesystem::is_regular_file(file, ec)) {
     problems.push_back(file + ": cannot read file");
     return false;
   }
@@ -99,6 +101,11 @@ bool read_pgm(const std::string& file, PgmImage& out, std::vector<std::string>& 
 bool load_map_server_grid(const std::string& yaml_file, const std::string& key_path, OccupancyGrid& out,
                           std::vector<std::string>& problems) {
   YAML::Node doc;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(yaml_file, ec)) {  // a directory opens, and reading it throws
+    problems.push_back(key_path + ": " + yaml_file + ": cannot read file (not a regular file)");
+    return false;
+  }
   try {
     doc = YAML::LoadFile(yaml_file);
   } catch (const YAML::Exception& e) {
