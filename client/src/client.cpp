@@ -151,6 +151,9 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   // within its window), and whether a wait for it should give up (service lost, no re-send).
   bool resend_pending_locked(std::uint64_t request_id, SteadyClock::time_point now) const;
   bool give_up_locked(std::uint64_t request_id, SteadyClock::time_point now) const;
+  // When a wait for request_id must look again: its deadline, or earlier the end of the request's
+  // resend window (give_up_locked may become true then with no sample arriving).
+  SteadyClock::time_point recheck_locked(std::uint64_t request_id, SteadyClock::time_point deadline) const;
   bool stale_locked(const Received<PullOutStatus>& item) const;
   template <typename T>
   void replace_callback(CallbackSlot<T>& slot, std::function<void(const T&)> callback);
@@ -188,8 +191,8 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   struct Pending {
     std::uint64_t id{0};
     std::shared_ptr<const msg::PullOutRequest> sample;
-    SteadyClock::time_point sent_at{};       // first write (send())
-    SteadyClock::time_point last_write{};    // latest write
+    SteadyClock::time_point sent_at{};     // first write (send())
+    SteadyClock::time_point last_write{};  // latest write
     bool answered{false};
   } pending_;
   ServiceState service_state_{ServiceState::kNotFound};
@@ -298,10 +301,10 @@ void Client::Impl::create_entities() {
   if (progress_writer_ == nullptr) throw ClientError("cannot create the pullout/progress writer");
   path_reader_ = create_reply_reader(path_topic, client_detail::kPathReaderProfile, kPathReaderDepth);
   status_reader_ = create_reply_reader(status_topic, client_detail::kStatusReaderProfile, kStatusReaderDepth);
-  path_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available() <<
-                                                           dds::StatusMask::subscription_matched());
-  status_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available() <<
-                                                             dds::StatusMask::subscription_matched());
+  path_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
+                                                           << dds::StatusMask::subscription_matched());
+  status_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
+                                                             << dds::StatusMask::subscription_matched());
   request_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
   progress_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
 }
@@ -309,9 +312,9 @@ void Client::Impl::create_entities() {
 dds::DataReader* Client::Impl::create_reply_reader(dds::Topic* topic, const char* profile, int depth) {
   const std::string topic_name = topic->get_name();
   // The name only has to be unique within this participant (one per client).
-  dds::ContentFilteredTopic* filtered = participant_->create_contentfilteredtopic(
-      topic_name + "/this_vehicle", topic, idl::kVehicleFilterExpression, {options_.vehicle_id},
-      idl::kVehicleFilterClass);
+  dds::ContentFilteredTopic* filtered =
+      participant_->create_contentfilteredtopic(topic_name + "/this_vehicle", topic, idl::kVehicleFilterExpression,
+                                                {options_.vehicle_id}, idl::kVehicleFilterClass);
   if (filtered == nullptr) throw ClientError("cannot create the vehicle filter on " + topic_name);
   dds::DataReader* reader = subscriber_->create_datareader(filtered, reader_qos(profile, depth));
   if (reader == nullptr) throw ClientError("cannot create the " + topic_name + " reader");
@@ -420,6 +423,12 @@ bool Client::Impl::give_up_locked(std::uint64_t request_id, SteadyClock::time_po
   return service_state_ == ServiceState::kLost && !resend_pending_locked(request_id, now);
 }
 
+SteadyClock::time_point Client::Impl::recheck_locked(std::uint64_t request_id, SteadyClock::time_point deadline) const {
+  if (pending_.id != request_id || pending_.answered) return deadline;
+  const auto window_end = pending_.sent_at + options_.resend_window;
+  return SteadyClock::now() < window_end ? std::min(deadline, window_end) : deadline;
+}
+
 bool Client::Impl::stale_locked(const Received<PullOutStatus>& item) const {
   return item.seq <= stale_status_seq_ && item.value->state == ExecutionState::kPlanning;
 }
@@ -444,7 +453,7 @@ SteadyClock::time_point Client::Impl::update_service_and_resend() {
     std::lock_guard<std::mutex> lock(state_mutex_);
     // A new reader of requests (a service that came back, or a second one): the volatile topic
     // gives it nothing that was written before, so the pending request goes again now.
-    const bool new_reader = request_matched.current_count > request_matches_ || request_matched.current_count_change > 0;
+    const bool new_reader = request_matched.current_count > request_matches_ || request_matched.total_count_change > 0;
     request_matches_ = request_matched.current_count;
     if (connected && service_state_ != ServiceState::kConnected) {
       service_state_ = ServiceState::kConnected;
@@ -462,8 +471,6 @@ SteadyClock::time_point Client::Impl::update_service_and_resend() {
       } else {
         next = std::min(next, std::max(due, now + std::chrono::milliseconds(1)));
       }
-      // Wake the waiters when the window closes (give_up_locked may change then).
-      next = std::min(next, std::max(pending_.sent_at + options_.resend_window, now + std::chrono::milliseconds(1)));
     }
   }
   if (changed) state_cv_.notify_all();
@@ -522,8 +529,8 @@ void Client::Impl::run() {
   SteadyClock::time_point next = SteadyClock::now();
   while (!stop_.load()) {
     // Until the next re-send is due; the bound only limits how long a missed wake-up could delay.
-    const auto wait = std::clamp<SteadyClock::duration>(next - SteadyClock::now(), std::chrono::milliseconds(1),
-                                                        kDispatchPeriod);
+    const auto wait =
+        std::clamp<SteadyClock::duration>(next - SteadyClock::now(), std::chrono::milliseconds(1), kDispatchPeriod);
     const auto wait_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
     waitset.wait(active, eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(wait_ns / 1000000000),
                                                         static_cast<std::uint32_t>(wait_ns % 1000000000)));
@@ -664,8 +671,8 @@ std::optional<PullOutPath> Client::Impl::wait_for_path(std::uint64_t request_id,
     }
     const auto now = SteadyClock::now();
     if (stop_.load() || now >= deadline || give_up_locked(request_id, now)) return std::nullopt;
-    // The dispatcher notifies on every reply and service change, and when a resend window closes.
-    state_cv_.wait_until(lock, deadline);
+    // The dispatcher notifies on every reply and service change.
+    state_cv_.wait_until(lock, recheck_locked(request_id, deadline));
   }
 }
 
@@ -686,7 +693,7 @@ std::optional<PullOutStatus> Client::Impl::wait_for_status(std::uint64_t request
   while (true) {
     const auto now = SteadyClock::now();
     if (stop_.load() || now >= deadline || give_up_locked(request_id, now)) return std::nullopt;
-    state_cv_.wait_until(lock, deadline);
+    state_cv_.wait_until(lock, recheck_locked(request_id, deadline));
     for (const auto& item : recent_statuses_) {
       if (item.seq > seen && !stale_locked(item) && accepts(*item.value)) return *item.value;
     }
@@ -734,9 +741,9 @@ bool Client::Impl::wait_for_service(Duration timeout) const {
   // The client's thread tracks the matched counts (update_service_and_resend) and notifies.
   const auto deadline = deadline_after(timeout);
   std::unique_lock<std::mutex> lock(state_mutex_);
-  return state_cv_.wait_until(lock, deadline,
-                              [&] { return stop_.load() || service_state_ == ServiceState::kConnected; }) &&
-         service_state_ == ServiceState::kConnected;
+  return state_cv_.wait_until(lock, deadline, [&] {
+    return stop_.load() || service_state_ == ServiceState::kConnected;
+  }) && service_state_ == ServiceState::kConnected;
 }
 
 // ------------------------------------------------------------------------------------------------

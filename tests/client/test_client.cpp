@@ -713,6 +713,21 @@ TEST(ClientRetryTest, AWaitNothingCanAnswerReturnsWhenTheServiceIsLost) {
   EXPECT_EQ(client.latest_status()->state, ExecutionState::kWaitingApproval);
 }
 
+TEST(ClientRetryTest, AWaitForAnUnansweredRequestEndsWithItsResendWindowWhenTheServiceIsLost) {
+  auto service = std::make_unique<FakeService>();
+  ClientOptions o = options("car-25");
+  o.resend_window = std::chrono::milliseconds(1500);
+  Client client(o);
+  ASSERT_TRUE(client.wait_for_service(10s));
+  const std::uint64_t id = client.send(PullOutRequest{});
+  ASSERT_TRUE(service->wait_request("car-25").has_value());
+  service.reset();  // lost with the request unanswered: re-sent (to no one) until the window ends
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(client.wait_for_path(id, 30s).has_value());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 10s) << "the wait ran to its timeout";
+  EXPECT_EQ(client.service_state(), ServiceState::kLost);
+}
+
 TEST(ClientOptionsTest, InvalidResendOptionsThrow) {
   ClientOptions o = options("car-24");
   o.resend_period = std::chrono::milliseconds(0);

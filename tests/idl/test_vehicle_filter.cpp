@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 #include <fastdds/dds/core/LoanableSequence.hpp>
 
-#include "pullout/msg/pulloutPubSubTypes.h"
 #include "pullout/idl/vehicle_filter.hpp"
+#include "pullout/msg/pulloutPubSubTypes.h"
 
 namespace pullout::idl {
 namespace {

@@ -142,9 +142,10 @@ void DdsEdge::create_entities(const DdsConfig& config) {
     qos.writer_resource_limits().reader_filters_allocation.increment = 64;
     if (!qos.liveliness().lease_duration.is_infinite()) {
       // Fast DDS 2.9 turns writer-side filtering off for a writer with a finite liveliness lease.
-      spdlog::warn("DDS profile {}: a finite liveliness lease disables writer-side filtering: every vehicle "
-                   "receives every vehicle's samples",
-                   profile);
+      spdlog::warn(
+          "DDS profile {}: a finite liveliness lease disables writer-side filtering: every vehicle "
+          "receives every vehicle's samples",
+          profile);
     }
     dds::DataWriter* writer = publisher_->create_datawriter(topic, qos, nullptr, dds::StatusMask::none());
     if (writer == nullptr) throw missing_profile(what, profile);

@@ -4,8 +4,8 @@
 // ExecutionProgress samples keyed by that id, and receives the PullOutPath and PullOutStatus
 // replies of that vehicle only. Path and status are read through a DDS content filter on
 // vehicle_id that the service evaluates at its writers, so other vehicles' replies are not even
-// sent to this client (bench/fleet_bytes.cpp: bytes per request flat in the fleet's size); the
-// client drops any other vehicle's sample that still arrives (a service without the filter, or a
+// sent to this client (bench/fleet_bytes.cpp, bench/RESULTS.md); the client drops any other
+// vehicle's sample that still arrives (a service without the filter, or a
 // service writer past its number of reader filters). Path and status readers are
 // transient-local, so a client started after the service replied still receives the vehicle's
 // latest path and status.
