@@ -32,8 +32,8 @@
 #include "pullout/idl/convert.hpp"
 #include "pullout/idl/guarded_type.hpp"
 #include "pullout/idl/security.hpp"
+#include "pullout/idl/vehicle_filter.hpp"
 #include "pullout/msg/pulloutPubSubTypes.h"
-#include "vehicle_filter.hpp"
 
 namespace pullout {
 
@@ -53,7 +53,8 @@ constexpr std::size_t kRecentStatuses = 32;
 // before the client's thread takes them. Late joiners still get only the writer's last sample.
 constexpr int kPathReaderDepth = 4;
 constexpr int kStatusReaderDepth = 8;
-constexpr auto kMatchPollPeriod = std::chrono::milliseconds(10);
+// The client's thread wakes at least this often (a missed wake-up, the matched counts).
+constexpr auto kDispatchPeriod = std::chrono::milliseconds(1000);
 
 std::int64_t system_now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -77,6 +78,12 @@ void validate_options(const ClientOptions& options) {
     throw std::invalid_argument(
         "ClientOptions.vehicle_id: with security_dir, it names a DDS partition and may not "
         "contain * ? [ ] or \\");
+  }
+  if (options.resend_window.count() < 0) {
+    throw std::invalid_argument("ClientOptions.resend_window: must not be negative");
+  }
+  if (options.resend_period.count() <= 0) {
+    throw std::invalid_argument("ClientOptions.resend_period: must be positive");
   }
 }
 
@@ -129,6 +136,7 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   std::uint64_t current_request_id() const;
   std::optional<std::uint32_t> current_segment() const;
   bool wait_for_service(Duration timeout) const;
+  ServiceState service_state() const;
 
   const ClientOptions& options() const { return options_; }
 
@@ -141,6 +149,18 @@ class __attribute__((visibility("hidden"))) Client::Impl {
 
   void run();
   void dispatch_once();
+  // Reads the matched counts; updates service_state_ and re-sends the pending request when a
+  // service (re)appeared or its period elapsed. Returns when the next re-send is due.
+  SteadyClock::time_point update_service_and_resend();
+  void resend_pending(std::uint64_t id);
+  // Under state_mutex_: whether request_id may still be re-sent (answered = false, current, and
+  // within its window), and whether a wait for it should give up (service lost, no re-send).
+  bool resend_pending_locked(std::uint64_t request_id, SteadyClock::time_point now) const;
+  bool give_up_locked(std::uint64_t request_id, SteadyClock::time_point now) const;
+  // When a wait for request_id must look again: its deadline, or earlier the end of the request's
+  // resend window (give_up_locked may become true then with no sample arriving).
+  SteadyClock::time_point recheck_locked(std::uint64_t request_id, SteadyClock::time_point deadline) const;
+  bool stale_locked(const Received<PullOutStatus>& item) const;
   template <typename T>
   void replace_callback(CallbackSlot<T>& slot, std::function<void(const T&)> callback);
   template <typename T>
@@ -154,7 +174,7 @@ class __attribute__((visibility("hidden"))) Client::Impl {
 
   // --- DDS entities: created in the constructor, deleted in the destructor. The filter factory is
   // registered with the participant, so it is declared first (destroyed last). ---
-  client_detail::VehicleIdFilterFactory filter_factory_;
+  idl::VehicleIdFilterFactory filter_factory_;
   dds::DomainParticipant* participant_{nullptr};
   dds::Publisher* publisher_{nullptr};
   dds::Subscriber* subscriber_{nullptr};
@@ -173,6 +193,22 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   std::uint64_t last_request_id_{0};
   std::uint64_t current_request_id_{0};
   bool sent_any_{false};
+  // The request being re-sent until answered: the current request, as written.
+  struct Pending {
+    std::uint64_t id{0};
+    std::shared_ptr<const msg::PullOutRequest> sample;
+    SteadyClock::time_point sent_at{};     // first write (send())
+    SteadyClock::time_point last_write{};  // latest write
+    bool answered{false};
+  } pending_;
+  ServiceState service_state_{ServiceState::kNotFound};
+  std::int32_t request_matches_{0};  // the request writer's current match count
+  // Statuses with seq <= this were received before the latest loss of the service.
+  std::uint64_t stale_status_seq_{0};
+
+  // Serialises request writes (the type support's scratch buffers; a re-send never overtakes a
+  // newer send()). Lock order: write_mutex_, then state_mutex_.
+  std::mutex write_mutex_;
 
   // --- callbacks, guarded by callback_mutex_ (never held while a callback runs). Lock order:
   // callback_mutex_, then state_mutex_. callback_cv_ signals the end of a callback. ---
@@ -243,7 +279,7 @@ void Client::Impl::create_entities() {
                                     " (the reason is in Fast DDS's log, category SECURITY)"
                               : std::string()));
   }
-  if (participant_->register_content_filter_factory(client_detail::kVehicleFilterClass, &filter_factory_) !=
+  if (participant_->register_content_filter_factory(idl::kVehicleFilterClass, &filter_factory_) !=
       ReturnCode::RETCODE_OK) {
     throw ClientError("cannot register the vehicle content filter");
   }
@@ -289,16 +325,20 @@ void Client::Impl::create_entities() {
   if (progress_writer_ == nullptr) throw ClientError("cannot create the pullout/progress writer");
   path_reader_ = create_reply_reader(path_topic, client_detail::kPathReaderProfile, kPathReaderDepth);
   status_reader_ = create_reply_reader(status_topic, client_detail::kStatusReaderProfile, kStatusReaderDepth);
-  path_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available());
-  status_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available());
+  path_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
+                                                           << dds::StatusMask::subscription_matched());
+  status_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
+                                                             << dds::StatusMask::subscription_matched());
+  request_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
+  progress_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
 }
 
 dds::DataReader* Client::Impl::create_reply_reader(dds::Topic* topic, const char* profile, int depth) {
   const std::string topic_name = topic->get_name();
   // The name only has to be unique within this participant (one per client).
-  dds::ContentFilteredTopic* filtered = participant_->create_contentfilteredtopic(
-      topic_name + "/this_vehicle", topic, client_detail::kVehicleFilterExpression, {options_.vehicle_id},
-      client_detail::kVehicleFilterClass);
+  dds::ContentFilteredTopic* filtered =
+      participant_->create_contentfilteredtopic(topic_name + "/this_vehicle", topic, idl::kVehicleFilterExpression,
+                                                {options_.vehicle_id}, idl::kVehicleFilterClass);
   if (filtered == nullptr) throw ClientError("cannot create the vehicle filter on " + topic_name);
   dds::DataReader* reader = subscriber_->create_datareader(filtered, reader_qos(profile, depth));
   if (reader == nullptr) throw ClientError("cannot create the " + topic_name + " reader");
@@ -346,6 +386,7 @@ std::uint64_t Client::Impl::send(PullOutRequest request) {
   std::uint64_t id = 0;
   std::uint64_t previous = 0;
   const std::int64_t now = system_now_ns();
+  std::lock_guard<std::mutex> write_lock(write_mutex_);
   {
     std::lock_guard<std::mutex> lock(state_mutex_);
     // Strictly increasing, and above any id a previous run issued before now (clock seeded).
@@ -359,14 +400,106 @@ std::uint64_t Client::Impl::send(PullOutRequest request) {
   request.vehicle_id = options_.vehicle_id;
   request.request_id = id;
   request.stamp_ns = now;
-  msg::PullOutRequest sample = idl::to_msg(request);
-  if (!request_writer_->write(&sample)) {
+  auto sample = std::make_shared<msg::PullOutRequest>(idl::to_msg(request));
+  if (!request_writer_->write(sample.get())) {
     std::lock_guard<std::mutex> lock(state_mutex_);
     if (current_request_id_ == id) current_request_id_ = previous;
     throw ClientError("cannot write request " + std::to_string(id) +
                       " (DDS write failed: sample too large for the type or transport, or writer error)");
   }
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    const auto written = SteadyClock::now();
+    // A reply that raced the write's return may already have answered it.
+    bool answered = false;
+    for (const auto& item : recent_paths_) answered = answered || item.value->request_id == id;
+    for (const auto& item : recent_statuses_) {
+      answered = answered || (item.value->request_id == id && item.value->state != ExecutionState::kPlanning);
+    }
+    pending_ = Pending{id, std::move(sample), written, written, answered};
+  }
+  wake_dispatcher();  // schedules the first re-send
   return id;
+}
+
+void Client::Impl::resend_pending(std::uint64_t id) {
+  std::lock_guard<std::mutex> write_lock(write_mutex_);
+  std::shared_ptr<const msg::PullOutRequest> sample;
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    // Checked under write_mutex_: a send() that replaced it meanwhile has already written.
+    if (!resend_pending_locked(id, SteadyClock::now())) return;
+    sample = pending_.sample;
+    pending_.last_write = SteadyClock::now();
+  }
+  // write() takes a non-const pointer but does not modify the sample.
+  if (!request_writer_->write(const_cast<msg::PullOutRequest*>(sample.get()))) {
+    EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "re-sending request " << id << " failed (DDS write)");
+  }
+}
+
+bool Client::Impl::resend_pending_locked(std::uint64_t request_id, SteadyClock::time_point now) const {
+  return pending_.id != 0 && pending_.id == request_id && pending_.id == current_request_id_ && !pending_.answered &&
+         now < pending_.sent_at + options_.resend_window;
+}
+
+bool Client::Impl::give_up_locked(std::uint64_t request_id, SteadyClock::time_point now) const {
+  return service_state_ == ServiceState::kLost && !resend_pending_locked(request_id, now);
+}
+
+SteadyClock::time_point Client::Impl::recheck_locked(std::uint64_t request_id, SteadyClock::time_point deadline) const {
+  if (pending_.id != request_id || pending_.answered) return deadline;
+  const auto window_end = pending_.sent_at + options_.resend_window;
+  return SteadyClock::now() < window_end ? std::min(deadline, window_end) : deadline;
+}
+
+bool Client::Impl::stale_locked(const Received<PullOutStatus>& item) const {
+  return item.seq <= stale_status_seq_ && item.value->state == ExecutionState::kPlanning;
+}
+
+SteadyClock::time_point Client::Impl::update_service_and_resend() {
+  dds::PublicationMatchedStatus request_matched;
+  dds::PublicationMatchedStatus progress_matched;
+  dds::SubscriptionMatchedStatus path_matched;
+  dds::SubscriptionMatchedStatus status_matched;
+  // Reading a status also resets its trigger in the wait set.
+  request_writer_->get_publication_matched_status(request_matched);
+  progress_writer_->get_publication_matched_status(progress_matched);
+  path_reader_->get_subscription_matched_status(path_matched);
+  status_reader_->get_subscription_matched_status(status_matched);
+  const bool connected = request_matched.current_count > 0 && progress_matched.current_count > 0 &&
+                         path_matched.current_count > 0 && status_matched.current_count > 0;
+  const auto now = SteadyClock::now();
+  std::uint64_t resend_id = 0;
+  SteadyClock::time_point next = now + kDispatchPeriod;
+  bool changed = false;
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    // A new reader of requests (a service that came back, or a second one): the volatile topic
+    // gives it nothing that was written before, so the pending request goes again now.
+    const bool new_reader = request_matched.current_count > request_matches_ || request_matched.total_count_change > 0;
+    request_matches_ = request_matched.current_count;
+    if (connected && service_state_ != ServiceState::kConnected) {
+      service_state_ = ServiceState::kConnected;
+      changed = true;
+    } else if (!connected && service_state_ == ServiceState::kConnected) {
+      service_state_ = ServiceState::kLost;
+      stale_status_seq_ = status_seq_;
+      changed = true;
+    }
+    if (resend_pending_locked(pending_.id, now)) {
+      const auto due = pending_.last_write + options_.resend_period;
+      if ((new_reader && request_matched.current_count > 0) || (due <= now && request_matched.current_count > 0)) {
+        resend_id = pending_.id;
+        next = std::min(next, now + options_.resend_period);
+      } else {
+        next = std::min(next, std::max(due, now + std::chrono::milliseconds(1)));
+      }
+    }
+  }
+  if (changed) state_cv_.notify_all();
+  if (resend_id != 0) resend_pending(resend_id);
+  return next;
 }
 
 void Client::Impl::report_progress(ExecutionProgress progress) {
@@ -413,16 +546,26 @@ void Client::Impl::run() {
   dds::WaitSet waitset;
   waitset.attach_condition(path_reader_->get_statuscondition());
   waitset.attach_condition(status_reader_->get_statuscondition());
+  waitset.attach_condition(request_writer_->get_statuscondition());
+  waitset.attach_condition(progress_writer_->get_statuscondition());
   waitset.attach_condition(wake_);
   dds::ConditionSeq active;
+  SteadyClock::time_point next = SteadyClock::now();
   while (!stop_.load()) {
-    // The timeout only bounds how long a missed wake-up could delay the next round.
-    waitset.wait(active, eprosima::fastrtps::Duration_t(1, 0));
+    // Until the next re-send is due; the bound only limits how long a missed wake-up could delay.
+    const auto wait =
+        std::clamp<SteadyClock::duration>(next - SteadyClock::now(), std::chrono::milliseconds(1), kDispatchPeriod);
+    const auto wait_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
+    waitset.wait(active, eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(wait_ns / 1000000000),
+                                                        static_cast<std::uint32_t>(wait_ns % 1000000000)));
     wake_.set_trigger_value(false);
     if (stop_.load()) break;
     dispatch_once();
+    next = update_service_and_resend();
   }
   waitset.detach_condition(wake_);
+  waitset.detach_condition(progress_writer_->get_statuscondition());
+  waitset.detach_condition(request_writer_->get_statuscondition());
   waitset.detach_condition(status_reader_->get_statuscondition());
   waitset.detach_condition(path_reader_->get_statuscondition());
 }
@@ -516,11 +659,13 @@ void Client::Impl::dispatch_once() {
     for (auto& path : paths) {
       // Before the first send(), follow the request the service last answered (restart case).
       if (!sent_any_) current_request_id_ = path->request_id;
+      if (path->request_id == pending_.id) pending_.answered = true;
       Received<PullOutPath> item{++path_seq_, std::move(path)};
       if (path_slot_.callback) path_out.push_back(item);
       push_bounded(recent_paths_, std::move(item), kRecentPaths);
     }
     for (auto& status : statuses) {
+      if (status->request_id == pending_.id && status->state != ExecutionState::kPlanning) pending_.answered = true;
       Received<PullOutStatus> item{++status_seq_, std::move(status)};
       if (status_slot_.callback) status_out.push_back(item);
       push_bounded(recent_statuses_, std::move(item), kRecentStatuses);
@@ -548,8 +693,10 @@ std::optional<PullOutPath> Client::Impl::wait_for_path(std::uint64_t request_id,
     for (auto it = recent_paths_.rbegin(); it != recent_paths_.rend(); ++it) {
       if (it->value->request_id == request_id) return *it->value;
     }
-    if (stop_.load() || SteadyClock::now() >= deadline) return std::nullopt;
-    state_cv_.wait_until(lock, deadline);
+    const auto now = SteadyClock::now();
+    if (stop_.load() || now >= deadline || give_up_locked(request_id, now)) return std::nullopt;
+    // The dispatcher notifies on every reply and service change.
+    state_cv_.wait_until(lock, recheck_locked(request_id, deadline));
   }
 }
 
@@ -560,18 +707,19 @@ std::optional<PullOutStatus> Client::Impl::wait_for_status(std::uint64_t request
     return s.request_id == request_id && (!predicate || predicate(s));
   };
   std::unique_lock<std::mutex> lock(state_mutex_);
-  // The latest status already received for this request.
+  // The latest status already received for this request (unless stale).
   for (auto it = recent_statuses_.rbegin(); it != recent_statuses_.rend(); ++it) {
     if (it->value->request_id != request_id) continue;
-    if (accepts(*it->value)) return *it->value;
+    if (!stale_locked(*it) && accepts(*it->value)) return *it->value;
     break;
   }
   std::uint64_t seen = status_seq_;
   while (true) {
-    if (stop_.load() || SteadyClock::now() >= deadline) return std::nullopt;
-    state_cv_.wait_until(lock, deadline);
+    const auto now = SteadyClock::now();
+    if (stop_.load() || now >= deadline || give_up_locked(request_id, now)) return std::nullopt;
+    state_cv_.wait_until(lock, recheck_locked(request_id, deadline));
     for (const auto& item : recent_statuses_) {
-      if (item.seq > seen && accepts(*item.value)) return *item.value;
+      if (item.seq > seen && !stale_locked(item) && accepts(*item.value)) return *item.value;
     }
     seen = status_seq_;
   }
@@ -585,8 +733,13 @@ std::optional<PullOutPath> Client::Impl::latest_path() const {
 
 std::optional<PullOutStatus> Client::Impl::latest_status() const {
   std::lock_guard<std::mutex> lock(state_mutex_);
-  if (recent_statuses_.empty()) return std::nullopt;
+  if (recent_statuses_.empty() || stale_locked(recent_statuses_.back())) return std::nullopt;
   return *recent_statuses_.back().value;
+}
+
+ServiceState Client::Impl::service_state() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  return service_state_;
 }
 
 std::uint64_t Client::Impl::current_request_id() const {
@@ -609,25 +762,12 @@ std::optional<std::uint32_t> Client::Impl::current_segment() const {
 }
 
 bool Client::Impl::wait_for_service(Duration timeout) const {
+  // The client's thread tracks the matched counts (update_service_and_resend) and notifies.
   const auto deadline = deadline_after(timeout);
-  while (true) {
-    dds::PublicationMatchedStatus request_matched;
-    dds::PublicationMatchedStatus progress_matched;
-    dds::SubscriptionMatchedStatus path_matched;
-    dds::SubscriptionMatchedStatus status_matched;
-    request_writer_->get_publication_matched_status(request_matched);
-    progress_writer_->get_publication_matched_status(progress_matched);
-    path_reader_->get_subscription_matched_status(path_matched);
-    status_reader_->get_subscription_matched_status(status_matched);
-    // Progress is volatile too: a sample written before its writer matched would be lost.
-    if (request_matched.current_count > 0 && progress_matched.current_count > 0 && path_matched.current_count > 0 &&
-        status_matched.current_count > 0) {
-      return true;
-    }
-    const auto now = SteadyClock::now();
-    if (now >= deadline) return false;
-    std::this_thread::sleep_for(std::min<SteadyClock::duration>(kMatchPollPeriod, deadline - now));
-  }
+  std::unique_lock<std::mutex> lock(state_mutex_);
+  return state_cv_.wait_until(lock, deadline, [&] {
+    return stop_.load() || service_state_ == ServiceState::kConnected;
+  }) && service_state_ == ServiceState::kConnected;
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -652,6 +792,7 @@ std::optional<PullOutStatus> Client::latest_status() const { return impl_->lates
 std::uint64_t Client::current_request_id() const { return impl_->current_request_id(); }
 std::optional<std::uint32_t> Client::current_segment() const { return impl_->current_segment(); }
 bool Client::wait_for_service(Duration timeout) const { return impl_->wait_for_service(timeout); }
+ServiceState Client::service_state() const { return impl_->service_state(); }
 const std::string& Client::vehicle_id() const { return impl_->options().vehicle_id; }
 int Client::domain_id() const { return impl_->options().domain_id; }
 

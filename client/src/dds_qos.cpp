@@ -24,6 +24,10 @@ dds::DomainParticipantQos loopback_participant_qos() {
   udp->receiveBufferSize = kSocketBufferBytes;
   qos.transport().use_builtin_transports = false;
   qos.transport().user_transports.push_back(udp);
+  // As config/dds/loopback.xml: the service notices a dead client within about 2 s.
+  qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(2, 0);
+  qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod =
+      eprosima::fastrtps::Duration_t(0, 500000000);
   return qos;
 }
 

@@ -22,7 +22,8 @@ using idl::kStatusTopic;
 
 // Loopback only: built-in transports (UDP on every interface, shared memory) off, one UDPv4
 // transport whitelisted to 127.0.0.1 with 4 MiB socket buffers (large paths, see
-// fastdds_notes.md). Independent of FASTRTPS_DEFAULT_PROFILES_FILE.
+// fastdds_notes.md), participant lease 2 s announced every 0.5 s (as config/dds/loopback.xml).
+// Independent of FASTRTPS_DEFAULT_PROFILES_FILE.
 eprosima::fastdds::dds::DomainParticipantQos loopback_participant_qos();
 
 // pullout/request and pullout/progress: reliable, volatile, keep last 1 (per vehicle).

@@ -623,11 +623,126 @@ TEST(ClientTest, RequestIdsIncreaseAcrossClientRestarts) {
   EXPECT_GT(b.send(PullOutRequest{}), first);
 }
 
+// --- re-sending and a lost service ---
+
+TEST(ClientRetryTest, AnUnansweredRequestIsResentUnchangedUntilAnswered) {
+  FakeService service;
+  ClientOptions o = options("car-20");
+  o.resend_period = std::chrono::milliseconds(100);
+  Client client(o);
+  ASSERT_TRUE(client.wait_for_service(10s));
+  const std::uint64_t id = client.send(PullOutRequest{});
+  const auto first = service.wait_request("car-20");
+  ASSERT_TRUE(first.has_value());
+  // Nothing answered: the same sample comes again.
+  const auto again = service.wait_request("car-20");
+  ASSERT_TRUE(again.has_value()) << "the unanswered request was not re-sent";
+  EXPECT_EQ(again->request_id, id);
+  EXPECT_EQ(again->stamp_ns, first->stamp_ns);
+  // planning does not answer it (the service may die before the search ends)...
+  service.publish(make_status("car-20", id, ExecutionState::kPlanning));
+  ASSERT_TRUE(client.wait_for_status(id, nullptr, 5s).has_value());
+  ASSERT_TRUE(service.wait_request("car-20").has_value());
+  ASSERT_TRUE(service.wait_request("car-20").has_value());
+  // ...the path does.
+  service.publish(make_path("car-20", id));
+  ASSERT_TRUE(client.wait_for_path(id, 5s).has_value());
+  EXPECT_EQ(client.current_request_id(), id);
+}
+
+TEST(ClientRetryTest, ARequestSentBeforeTheServiceExistedReachesItWhenItAppears) {
+  ClientOptions o = options("car-21");
+  Client client(o);
+  const std::uint64_t id = client.send(PullOutRequest{});  // no reader yet: a volatile write is lost
+  FakeService service;
+  const auto got = service.wait_request("car-21", 10000ms);
+  ASSERT_TRUE(got.has_value()) << "the request was not re-sent to the service that appeared";
+  EXPECT_EQ(got->request_id, id);
+  service.publish(make_path("car-21", id));
+  EXPECT_TRUE(client.wait_for_path(id, 5s).has_value());
+}
+
+TEST(ClientRetryTest, APlanningStatusOfALostServiceIsNeverReported) {
+  auto service = std::make_unique<FakeService>();
+  Client client(options("car-22"));
+  ASSERT_TRUE(client.wait_for_service(10s));
+  EXPECT_EQ(client.service_state(), ServiceState::kConnected);
+  const std::uint64_t id = client.send(PullOutRequest{});
+  service->publish(make_status("car-22", id, ExecutionState::kPlanning));
+  ASSERT_TRUE(client.wait_for_status(id, nullptr, 5s).has_value());
+  ASSERT_TRUE(client.latest_status().has_value());
+  service.reset();  // deleted: its endpoints unmatch at once
+  ASSERT_TRUE(eventually([&] { return !client.latest_status().has_value(); }, 5000ms))
+      << "latest_status() still says " << static_cast<int>(client.latest_status()->state) << " from a lost service";
+  EXPECT_EQ(client.service_state(), ServiceState::kLost);
+  EXPECT_FALSE(client.wait_for_status(id, nullptr, 0ms).has_value());
+  // The next service answers the re-sent request: its statuses are reported again.
+  FakeService next;
+  ASSERT_TRUE(next.wait_request("car-22", 10000ms).has_value());
+  next.publish(make_status("car-22", id, ExecutionState::kPlanning));
+  ASSERT_TRUE(client.wait_for_status(id, nullptr, 5s).has_value());
+  EXPECT_EQ(client.latest_status()->state, ExecutionState::kPlanning);
+  EXPECT_EQ(client.service_state(), ServiceState::kConnected);
+}
+
+TEST(ClientRetryTest, AWaitNothingCanAnswerReturnsWhenTheServiceIsLost) {
+  auto service = std::make_unique<FakeService>();
+  ClientOptions o = options("car-23");
+  Client client(o);
+  ASSERT_TRUE(client.wait_for_service(10s));
+  const std::uint64_t id = client.send(PullOutRequest{});
+  service->publish(make_path("car-23", id));
+  service->publish(make_status("car-23", id, ExecutionState::kWaitingApproval));
+  ASSERT_TRUE(client.wait_for_status(id, nullptr, 5s).has_value());
+  // Answered: it is not re-sent, so once the service is gone nothing can bring `executing`.
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(200ms);
+    service.reset();
+  });
+  const auto start = std::chrono::steady_clock::now();
+  const auto executing = client.wait_for_status(
+      id, [](const PullOutStatus& s) { return s.state == ExecutionState::kExecuting; }, 30s);
+  const auto waited = std::chrono::steady_clock::now() - start;
+  stopper.join();
+  EXPECT_FALSE(executing.has_value());
+  EXPECT_LT(waited, 10s) << "the wait ran to its timeout";
+  EXPECT_EQ(client.service_state(), ServiceState::kLost);
+  // The path and the last status are kept (only planning is stale).
+  EXPECT_TRUE(client.latest_path().has_value());
+  ASSERT_TRUE(client.latest_status().has_value());
+  EXPECT_EQ(client.latest_status()->state, ExecutionState::kWaitingApproval);
+}
+
+TEST(ClientRetryTest, AWaitForAnUnansweredRequestEndsWithItsResendWindowWhenTheServiceIsLost) {
+  auto service = std::make_unique<FakeService>();
+  ClientOptions o = options("car-25");
+  o.resend_window = std::chrono::milliseconds(1500);
+  Client client(o);
+  ASSERT_TRUE(client.wait_for_service(10s));
+  const std::uint64_t id = client.send(PullOutRequest{});
+  ASSERT_TRUE(service->wait_request("car-25").has_value());
+  service.reset();  // lost with the request unanswered: re-sent (to no one) until the window ends
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(client.wait_for_path(id, 30s).has_value());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 10s) << "the wait ran to its timeout";
+  EXPECT_EQ(client.service_state(), ServiceState::kLost);
+}
+
+TEST(ClientOptionsTest, InvalidResendOptionsThrow) {
+  ClientOptions o = options("car-24");
+  o.resend_period = std::chrono::milliseconds(0);
+  EXPECT_THROW(Client{o}, std::invalid_argument);
+  o = options("car-24");
+  o.resend_window = std::chrono::milliseconds(-1);
+  EXPECT_THROW(Client{o}, std::invalid_argument);
+}
+
 TEST(ClientTest, NoServiceMeansNoMatch) {
   ClientOptions o = options("car-8");
   o.domain_id = 231;  // no test ever runs a (fake) service there
   Client client(o);
   EXPECT_FALSE(client.wait_for_service(200ms));
+  EXPECT_EQ(client.service_state(), ServiceState::kNotFound);
 }
 
 }  // namespace

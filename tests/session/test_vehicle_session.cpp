@@ -265,6 +265,60 @@ TEST_F(Session, AResentRequestWithinTheThrottleOnlyReplacesTheObjects) {
   EXPECT_EQ(e.path->partial_paths.size(), found.path->partial_paths.size());
 }
 
+// The client's retry re-sends the very sample (same request id and stamp) until answered.
+TEST_F(Session, ARepeatedRequestWhilePlanningOrdersNoSecondSearch) {
+  PullOutRequest r = test::straight_shoulder_request();
+  r.stamp_ns = 77;
+  const SessionEffects first = session_->on_request(r, {}, now_);
+  ASSERT_TRUE(first.search);
+  now_ += seconds(1);
+  const SessionEffects again = session_->on_request(r, {}, now_);
+  EXPECT_FALSE(again.search);
+  EXPECT_FALSE(again.cancel_search);
+  EXPECT_FALSE(again.path);
+  ASSERT_TRUE(again.status);
+  EXPECT_EQ(again.status->state, ExecutionState::kPlanning);
+  EXPECT_EQ(session_->pending_search(), first.search->sequence);
+  // The search ordered first still counts.
+  const PlanningResult result = planner_->plan(first.search->request, StopCondition());
+  const SessionEffects done = session_->on_result(first.search->sequence, result, now_);
+  ASSERT_TRUE(done.path);
+  EXPECT_TRUE(done.path->found);
+}
+
+TEST_F(Session, ARepeatedRequestAfterPlanningRepublishesThePathWithoutASearch) {
+  PullOutRequest r = test::straight_shoulder_request();
+  r.stamp_ns = 77;
+  const SessionEffects found = plan(r);
+  ASSERT_TRUE(found.path && found.path->found);
+  now_ += seconds(5);  // past the re-plan throttle: a new request would plan afresh
+  const SessionEffects again = session_->on_request(r, {}, now_);
+  EXPECT_FALSE(again.search);
+  ASSERT_TRUE(again.path && again.status);
+  EXPECT_EQ(again.path->request_id, r.request_id);
+  EXPECT_EQ(again.path->partial_paths.size(), found.path->partial_paths.size());
+  EXPECT_EQ(again.status->state, ExecutionState::kWaitingApproval);
+}
+
+TEST_F(Session, TheSameIdWithAnotherStampIsANewRequest) {
+  PullOutRequest r = test::straight_shoulder_request();
+  r.stamp_ns = 77;
+  plan(r);
+  now_ += seconds(5);
+  r.stamp_ns = 78;
+  EXPECT_TRUE(session_->on_request(r, {}, now_).search);
+}
+
+TEST_F(Session, ARepeatedRejectedRequestIsRejectedAgainWithoutASearch) {
+  PullOutRequest r = test::straight_shoulder_request();
+  r.ego_pose.x = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_EQ(session_->on_request(r, {}, now_).status->state, ExecutionState::kRejected);
+  const SessionEffects again = session_->on_request(r, {}, now_);
+  EXPECT_FALSE(again.search);
+  ASSERT_TRUE(again.status);
+  EXPECT_EQ(again.status->state, ExecutionState::kRejected);
+}
+
 TEST_F(Session, AResentRequestAfterTheThrottleReplans) {
   plan(test::straight_shoulder_request());
   PullOutRequest again = test::straight_shoulder_request();

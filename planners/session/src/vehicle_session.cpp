@@ -105,6 +105,18 @@ SessionEffects VehicleSession::reject(std::uint64_t request_id, const std::vecto
 SessionEffects VehicleSession::on_request(PullOutRequest request, const std::vector<RequestIssue>& conversion_issues,
                                           Clock::time_point now) {
   last_input_ = now;
+  // A repeated request (the client re-sends the sample it wrote until it is answered): the same
+  // id and stamp as the latest request. No second search and no change: the session answers with
+  // what it has, the status (planning while the search runs) and the path it follows for that id.
+  if (status_.state != ExecutionState::kIdle && request.request_id == status_.request_id &&
+      request.stamp_ns == request_stamp_ns_) {
+    SessionEffects out;
+    if (path_ && has_path(status_.state) && published_.request_id == request.request_id) out.path = stamped(published_);
+    out.status = status_;
+    out.note = "repeated request " + std::to_string(request.request_id) + ": answered with the current state";
+    return out;
+  }
+  request_stamp_ns_ = request.stamp_ns;
   // Validated in full before anything of it is kept, whatever happens to it next.
   const std::vector<RequestIssue> issues = conversion_issues.empty() ? planner_.validate(request) : conversion_issues;
   if (!issues.empty()) return reject(request.request_id, issues);

@@ -16,6 +16,7 @@
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -235,12 +236,31 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   progress_reader_ = subscriber_->create_datareader_with_profile(progress_topic_, kProgressReaderProfile, nullptr,
                                                                  dds::StatusMask::none());
   if (progress_reader_ == nullptr) throw missing_profile("progress reader", kProgressReaderProfile);
-  path_writer_ =
-      publisher_->create_datawriter_with_profile(path_topic_, kPathWriterProfile, nullptr, dds::StatusMask::none());
-  if (path_writer_ == nullptr) throw missing_profile("path writer", kPathWriterProfile);
-  status_writer_ =
-      publisher_->create_datawriter_with_profile(status_topic_, kStatusWriterProfile, nullptr, dds::StatusMask::none());
-  if (status_writer_ == nullptr) throw missing_profile("status writer", kStatusWriterProfile);
+  // Writer-side filtering: the factory must be known before a reader is discovered.
+  if (participant_->register_content_filter_factory(idl::kVehicleFilterClass, &filter_factory_) !=
+      ReturnCode_t::RETCODE_OK) {
+    throw DdsSetupError("cannot register the vehicle content filter factory");
+  }
+  const auto filtering_writer = [&](dds::Topic* topic, const char* what, const char* profile) {
+    dds::DataWriterQos qos;
+    if (publisher_->get_datawriter_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK) {
+      throw missing_profile(what, profile);
+    }
+    qos.writer_resource_limits().reader_filters_allocation.maximum = idl::kMaxWriterReaderFilters;
+    qos.writer_resource_limits().reader_filters_allocation.increment = 64;
+    if (!qos.liveliness().lease_duration.is_infinite()) {
+      // Fast DDS 2.9 turns writer-side filtering off for a writer with a finite liveliness lease.
+      spdlog::warn(
+          "DDS profile {}: a finite liveliness lease disables writer-side filtering: every vehicle "
+          "receives every vehicle's samples",
+          profile);
+    }
+    dds::DataWriter* writer = publisher_->create_datawriter(topic, qos, nullptr, dds::StatusMask::none());
+    if (writer == nullptr) throw missing_profile(what, profile);
+    return writer;
+  };
+  path_writer_ = filtering_writer(path_topic_, "path writer", kPathWriterProfile);
+  status_writer_ = filtering_writer(status_topic_, "status writer", kStatusWriterProfile);
 }
 
 void DdsEdge::check_qos() const {

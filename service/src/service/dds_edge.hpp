@@ -6,6 +6,11 @@
 //   readers      pullout_request_reader, pullout_progress_reader
 //   writers      pullout_path_writer, pullout_status_writer
 //
+// The path and status writers filter at the writer: the vehicle content filter factory
+// (pullout/idl/vehicle_filter.hpp) is registered on the participant, and each writer evaluates
+// the filters of up to idl::kMaxWriterReaderFilters remote readers (set in code: Fast DDS 2.9's
+// XML has no element for it), so each vehicle's samples are sent to that vehicle's readers only.
+//
 // Construction loads the XML and creates everything, or throws DdsSetupError naming the step that
 // failed (after deleting whatever was created). Destruction deletes every entity and the
 // participant, which also removes the participant's shared-memory files.
@@ -30,6 +35,7 @@
 
 #include "pullout/config/config.hpp"
 #include "pullout/idl/topics.hpp"
+#include "pullout/idl/vehicle_filter.hpp"
 #include "service/outbox.hpp"
 
 namespace eprosima::fastdds::dds {
@@ -111,6 +117,8 @@ class DdsEdge final : public Outbox {
   void delete_vehicle_writers(VehicleWriters& writers) noexcept;
   void forget_secure_vehicle(const std::string& vehicle_id);
 
+  // Registered with the participant: declared first, destroyed after it.
+  idl::VehicleIdFilterFactory filter_factory_;
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
   eprosima::fastdds::dds::Publisher* publisher_{nullptr};
   eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};

@@ -2,9 +2,33 @@
 //
 // One Client speaks for one vehicle (ClientOptions::vehicle_id). It publishes PullOutRequest and
 // ExecutionProgress samples keyed by that id, and receives the PullOutPath and PullOutStatus
-// replies of that vehicle only (replies for other vehicles are dropped before they reach the
-// reader's history). Path and status readers are transient-local, so a client started after the
-// service replied still receives the vehicle's latest path and status.
+// replies of that vehicle only. Path and status are read through a DDS content filter on
+// vehicle_id that the service evaluates at its writers, so other vehicles' replies are not even
+// sent to this client (bench/fleet_bytes.cpp, bench/RESULTS.md); the client drops any other
+// vehicle's sample that still arrives (a service without the filter, or a
+// service writer past its number of reader filters). Path and status readers are
+// transient-local, so a client started after the service replied still receives the vehicle's
+// latest path and status.
+//
+// Re-sending and a lost service. A request is answered when its path, or a status for it in a
+// state other than planning, has been received. Until then the client re-sends it, unchanged
+// (same request id, same stamp), every ClientOptions::resend_period and at once when a service
+// (re)appears, for at most ClientOptions::resend_window after send(); the service answers a
+// re-sent request idempotently (no second search: it re-publishes what it has). So a request
+// sent before the service was up, or outstanding when the service died, is answered by the next
+// service without the caller re-sending. A newer send() replaces the request being re-sent.
+// The client sees the service as connected while its request and progress writers and its path
+// and status readers are each matched with a service endpoint (service_state()). A service that
+// is killed is lost after its participant lease: the shipped profiles (config/dds/loopback.xml,
+// network.xml) announce 2 s (loopback) and 4 s (network), so a dead service is noticed within
+// about that (tests/integration/test_service_restart.cpp asserts < 5 s on loopback; Fast DDS's
+// default lease was 20 s). A service that stops cleanly is lost at once. When the service is
+// lost: a planning status it sent is stale (that search will never finish) and is never reported
+// again (latest_status(), wait_for_status()), and waits for a request that will not be re-sent
+// any more (answered, superseded, or past its resend window) return std::nullopt at once with
+// service_state() == ServiceState::kLost as the reason, instead of running to their timeout.
+// Paths and other statuses received before the loss are kept: a found path is still a valid path,
+// but no one follows its execution or checks its safety until a service answers again.
 //
 // DDS setup: with an empty ClientOptions::profiles_file the participant and the topic QoS are
 // built in code: loopback only (built-in transports off, one UDPv4 transport whitelisted to
@@ -65,6 +89,17 @@ struct ClientOptions {
   // vehicle_id may not contain * ? [ ] or \. The service must run with security too
   // (dds.security_dir). README, "DDS Security".
   std::string security_dir;
+  // An unanswered request is re-sent every resend_period (> 0), for at most resend_window after
+  // send() (>= 0; zero: never re-sent). See "Re-sending and a lost service" above.
+  std::chrono::milliseconds resend_period{1000};
+  std::chrono::milliseconds resend_window{10000};
+};
+
+// The client's view of the service (see "Re-sending and a lost service" above).
+enum class ServiceState {
+  kNotFound,   // never matched since the client was created
+  kConnected,  // every endpoint matched with the service
+  kLost,       // was connected, then an endpoint lost its match (lease expired, or service stopped)
 };
 
 // A DDS failure: the participant, a topic or an endpoint could not be created, a profiles file
@@ -96,9 +131,10 @@ class PULLOUT_CLIENT_EXPORT Client {
   // client's vehicle, request.request_id with a fresh id and request.stamp_ns with the system
   // clock. Ids are strictly increasing within a client and seeded from the system clock [ns], so
   // they stay unique (and increasing) across client restarts as long as the clock does not step
-  // back. Returns the id. Does not wait for the service: a request sent before the service is
-  // matched is lost (the topic is volatile); call wait_for_service first. Throws ClientError when
-  // the sample cannot be written (e.g. it exceeds the transport's maximum size).
+  // back. Returns the id. Does not wait for the service: the topic is volatile, so a request sent
+  // before the service is matched reaches it only by being re-sent (within resend_window; call
+  // wait_for_service first when resending is off). Throws ClientError when the sample cannot be
+  // written (e.g. it exceeds the transport's maximum size); a failed re-send is only logged.
   std::uint64_t send(PullOutRequest request);
 
   // Publishes the vehicle's progress. Overwrites progress.vehicle_id; a request_id of 0 becomes
@@ -117,21 +153,30 @@ class PULLOUT_CLIENT_EXPORT Client {
   void on_status(StatusCallback callback);
 
   // Blocks until the path for request_id has been received or the timeout expires. Returns at
-  // once if it is among the recently received paths (the last 16). std::nullopt on timeout.
+  // once if it is among the recently received paths (the last 16). std::nullopt on timeout, and
+  // before it when the service is lost and request_id will not be re-sent (see above).
   std::optional<PullOutPath> wait_for_path(std::uint64_t request_id, Duration timeout) const;
 
   // Blocks until a status for request_id satisfies predicate (an empty predicate accepts any),
   // considering the latest status already received for that request, then each later one. The
   // predicate runs on the calling thread with an internal lock held: keep it a cheap, pure test.
-  // std::nullopt on timeout. Note: the status reader keeps the last status of the vehicle only,
+  // std::nullopt on timeout, and before it when the service is lost and request_id will not be
+  // re-sent; a planning status received before a loss is not considered. Note: the status reader
+  // keeps the last status of the vehicle only,
   // so short-lived intermediate states may be skipped; wait for the state you need, not for a
   // transition.
   std::optional<PullOutStatus> wait_for_status(std::uint64_t request_id, const StatusPredicate& predicate,
                                                Duration timeout) const;
 
   // The latest path / status received for this vehicle (whatever request it answers).
+  // latest_status() is std::nullopt (until the next status arrives) when the latest one says
+  // planning and the service was lost after it came: that search will never finish.
   std::optional<PullOutPath> latest_path() const;
   std::optional<PullOutStatus> latest_status() const;
+
+  // Whether the service is connected, lost, or was never found. Changes on the client's thread as
+  // DDS reports matches (a killed service: after its participant lease, see above).
+  ServiceState service_state() const;
 
   // The request this client follows: the id returned by the last send(), or, before the first
   // send(), the request of the latest path received (a restarted client adopts it). 0 when none.

@@ -12,6 +12,9 @@
 //   on_request (invalid)      -> kRejected: a path with found = false and the field-named issues
 //   on_request (re-sent)      -> same state: only the objects of the safety check change, the
 //                                current path (as published) is re-published under the new id
+//   on_request (repeated: the same request id and stamp as the latest request, as the client's
+//              retry sends it) -> nothing changes and no search: the status is re-published, and
+//                                the path when one is followed for that id (idempotent)
 //   on_result (found)         -> kWaitingApproval, with the safety verdict at the start pose
 //   on_result (no path)       -> kNoPath (the stop path)       on_result (rejected) -> kRejected
 //   on_progress, not approved -> kWaitingApproval
@@ -158,6 +161,7 @@ class VehicleSession {
   PullOutStatus status_;       // the last status published
   Clock::time_point last_input_{};
 
+  std::int64_t request_stamp_ns_{0};  // of the latest request, accepted or not
   // Of the latest accepted request.
   Pose2 goal_;
   Pose2 request_ego_;

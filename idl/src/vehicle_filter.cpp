@@ -1,9 +1,9 @@
-#include "vehicle_filter.hpp"
+#include "pullout/idl/vehicle_filter.hpp"
 
 #include <algorithm>
 #include <cstring>
 
-namespace pullout::client_detail {
+namespace pullout::idl {
 
 namespace dds = eprosima::fastdds::dds;
 using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
@@ -81,4 +81,4 @@ ReturnCode VehicleIdFilterFactory::delete_content_filter(const char* /*filter_cl
   return ReturnCode::RETCODE_OK;
 }
 
-}  // namespace pullout::client_detail
+}  // namespace pullout::idl

@@ -1,5 +1,12 @@
-// A content filter that keeps the samples of one vehicle, so that a client's readers never store
-// (nor count against their resource limits) the replies of other vehicles.
+// The vehicle content filter: keeps the samples of one vehicle. Shared by both DDS edges.
+//
+// The client reads pullout/path and pullout/status through a ContentFilteredTopic of this filter
+// class (expression kVehicleFilterExpression, parameter: its vehicle id). The service registers
+// the same factory on its participant, so that Fast DDS evaluates each remote reader's filter at
+// the service's writers (writer-side filtering, Fast DDS >= 2.6): a vehicle's path and status are
+// sent to that vehicle's reader only, and every other reader gets a small GAP instead of the
+// sample. Without the factory at the writer, the filter runs in the reader, after the bytes
+// crossed the wire (every reply to every vehicle: N^2 traffic for a fleet of N).
 //
 // Fast DDS's built-in SQL filter needs type objects, which pullout's generated types do not have
 // (fastdds_notes.md), so this custom filter class reads the key straight from the serialized
@@ -9,7 +16,7 @@
 // sample's vehicle_id again on reception).
 //
 // The filter runs on Fast DDS receive threads: evaluate() is const and reads only the vehicle id
-// fixed at creation. Internal to the client library.
+// fixed at creation. Not part of the client's public headers.
 #pragma once
 
 #include <cstddef>
@@ -23,10 +30,22 @@
 #include <fastdds/dds/topic/IContentFilter.hpp>
 #include <fastdds/dds/topic/IContentFilterFactory.hpp>
 
-namespace pullout::client_detail {
+namespace pullout::idl {
 
 inline constexpr const char* kVehicleFilterClass = "PULLOUT_VEHICLE_ID";
 inline constexpr const char* kVehicleFilterExpression = "vehicle_id = %0";
+
+// Reader filters a service writer evaluates itself (DataWriterQos::writer_resource_limits()
+// .reader_filters_allocation.maximum; Fast DDS's default is 32: the 33rd vehicle and every later
+// one would receive every vehicle's replies again). Readers past this many are served unfiltered
+// (their client drops other vehicles' samples). The bound: each sample a filtering writer sends
+// carries a PID_CONTENT_FILTER_INFO inline QoS of 16 bytes per reader filter plus a 32-bit bitmap
+// word per 32 filters, and that parameter's length is 16 bits, so Fast DDS 2.9.1 cannot encode
+// more than 4,063 filters (past that it filters for no reader at all). Costs at the writer, per
+// sample: one filter evaluation per reader and 16 bytes of inline QoS per reader filter (at 4,000
+// vehicles, 64 KB on the one DATA that is sent); and every history sample keeps the list of the
+// readers that filtered it out (16 bytes each).
+inline constexpr int kMaxWriterReaderFilters = 4000;
 
 // Whether a serialized sample (data[0..size), starting with the encapsulation header) whose first
 // member is a string carries `vehicle_id` there. True when the encapsulation is not plain CDR
@@ -54,4 +73,4 @@ class VehicleIdFilterFactory final : public eprosima::fastdds::dds::IContentFilt
   std::vector<std::unique_ptr<Filter>> filters_;
 };
 
-}  // namespace pullout::client_detail
+}  // namespace pullout::idl

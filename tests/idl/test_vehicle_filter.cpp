@@ -1,4 +1,4 @@
-// The client's vehicle content filter: it reads vehicle_id straight from serialized samples, so
+// The vehicle content filter: it reads vehicle_id straight from serialized samples, so
 // check it on samples serialized by the generated types, and on malformed payloads.
 #include <cstdint>
 #include <string>
@@ -7,10 +7,10 @@
 #include <gtest/gtest.h>
 #include <fastdds/dds/core/LoanableSequence.hpp>
 
+#include "pullout/idl/vehicle_filter.hpp"
 #include "pullout/msg/pulloutPubSubTypes.h"
-#include "vehicle_filter.hpp"
 
-namespace pullout::client_detail {
+namespace pullout::idl {
 namespace {
 
 using eprosima::fastrtps::rtps::SerializedPayload_t;
@@ -111,4 +111,4 @@ TEST(VehicleFilterFactory, AcceptsOnlyItsExpression) {
 }
 
 }  // namespace
-}  // namespace pullout::client_detail
+}  // namespace pullout::idl
