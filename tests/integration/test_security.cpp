@@ -54,8 +54,8 @@ using namespace std::chrono_literals;
 const std::string& pki_dir() {
   static const TempDir dir;
   static const bool made = [] {
-    const std::string command = "bash '" + source_path("scripts/make-test-pki") + "' '" + dir.path() +
-                                "/pki' car-1 car-2 >/dev/null";
+    const std::string command =
+        "bash '" + source_path("scripts/make-test-pki") + "' '" + dir.path() + "/pki' car-1 car-2 >/dev/null";
     return std::system(command.c_str()) == 0;
   }();
   static const std::string path = made ? dir.path() + "/pki" : std::string();
@@ -133,14 +133,12 @@ class RawParticipant {
   bool write_acknowledged(const PullOutRequest& request) {
     msg::PullOutRequest sample = idl::to_msg(request);
     return request_writer_->write(&sample) &&
-           request_writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0)) ==
-               ReturnCode_t::RETCODE_OK;
+           request_writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0)) == ReturnCode_t::RETCODE_OK;
   }
   bool write_acknowledged(const ExecutionProgress& progress) {
     msg::ExecutionProgress sample = idl::to_msg(progress);
-    return progress_writer_->write(&sample) &&
-           progress_writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0)) ==
-               ReturnCode_t::RETCODE_OK;
+    return progress_writer_->write(&sample) && progress_writer_->wait_for_acknowledgments(
+                                                   eprosima::fastrtps::Duration_t(10, 0)) == ReturnCode_t::RETCODE_OK;
   }
 
   // The vehicle ids of the paths received so far (taken: each id once per sample).
@@ -204,9 +202,8 @@ class SecurityTest : public ::testing::Test {
  protected:
   void SetUp() override {
     ASSERT_FALSE(pki_dir().empty()) << "scripts/make-test-pki failed";
-    const std::string config = temp_.write_file(
-        "secure.yaml", "dds:\n  profiles_file: " + loopback_profiles_path() + "\n  security_dir: " + pki_dir() +
-                           "/service\n");
+    const std::string config = temp_.write_file("secure.yaml", "dds:\n  profiles_file: " + loopback_profiles_path() +
+                                                                   "\n  security_dir: " + pki_dir() + "/service\n");
     ServiceOptions options;
     options.executable = PULLOUT_SERVICE_EXE;
     options.config_path = config;
