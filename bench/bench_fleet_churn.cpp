@@ -119,7 +119,8 @@ int run(int argc, char** argv) {
   integration::ServiceProcess service(options);
   const pid_t pid = service.pid();
   const std::string profiles = source_path("config/dds/loopback.xml");
-  const pullout::PullOutRequest base = pullout::load_scenario(source_path("tests/scenarios/straight_shoulder.yaml")).request;
+  const pullout::PullOutRequest base =
+      pullout::load_scenario(source_path("tests/scenarios/straight_shoulder.yaml")).request;
   std::printf("bench_fleet_churn: domain %d, service pid %d, load %s\n\n", service.domain(), static_cast<int>(pid),
               load_text().c_str());
 
@@ -162,7 +163,8 @@ int run(int argc, char** argv) {
   std::atomic<std::size_t> done{0};
   std::atomic<bool> stop{false};
   const auto t0 = SteadyClock::now();
-  const auto deadline = t0 + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(max_seconds));
+  const auto deadline =
+      t0 + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(max_seconds));
   std::vector<std::pair<double, std::pair<std::size_t, double>>> rss_samples;  // t [s], (done, MB)
   std::thread monitor([&] {
     while (!stop) {
@@ -225,8 +227,9 @@ int run(int argc, char** argv) {
       ++unexpected;
     }
   }
-  std::printf("churn: %zu vehicles in %.1f s (%.0f vehicles/s), %d clients; not answered %zu, answered otherwise %zu\n\n",
-              attempted, wall_s, static_cast<double>(attempted) / wall_s, clients, lost, unexpected);
+  std::printf(
+      "churn: %zu vehicles in %.1f s (%.0f vehicles/s), %d clients; not answered %zu, answered otherwise %zu\n\n",
+      attempted, wall_s, static_cast<double>(attempted) / wall_s, clients, lost, unexpected);
 
   std::printf("| t [s] | vehicles served | service RSS [MB] |\n|---|---|---|\n");
   const std::size_t step = std::max<std::size_t>(1, rss_samples.size() / 12);

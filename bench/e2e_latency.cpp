@@ -31,8 +31,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <optional>
 #include <string>
@@ -393,9 +393,9 @@ int run_bench(int requests, int warmup, int pings, int plans) {
     if (std::system(command.c_str()) != 0) throw std::runtime_error("scripts/make-test-pki failed");
     integration::ServiceOptions options;
     options.executable = service_exe;
-    options.config_path = dir.write_file("secure.yaml", "dds:\n  profiles_file: " +
-                                                            source_path("config/dds/loopback.xml") +
-                                                            "\n  security_dir: " + pki + "/service\n");
+    options.config_path =
+        dir.write_file("secure.yaml", "dds:\n  profiles_file: " + source_path("config/dds/loopback.xml") +
+                                          "\n  security_dir: " + pki + "/service\n");
     options.domain = lease.domain();
     options.probe_security_dir = pki + "/vehicles/bench-e2e";
     options.probe_vehicle_id = "bench-e2e";
@@ -460,11 +460,11 @@ int run_bench(int requests, int warmup, int pings, int plans) {
       e2e_s.p50, floor, plan_s.p50, asym_s.p50, e2e_s.p50 - floor);
   std::printf("with the reply-sized round trip both ways: floor %.3f ms, overhead %.3f ms\n", plan_s.p50 + sym_s.p50,
               e2e_s.p50 - plan_s.p50 - sym_s.p50);
-  std::printf("lost: e2e %zu, secure e2e %zu, ping-pong %zu; service %s, %zu file(s) left in /dev/shm; secure "
-              "service %s, %zu file(s); echo %s\n",
-              e2e.lost, secure.lost, ping.lost, service_report.exit.describe().c_str(),
-              service_report.leaked_shm_files.size(), secure_report.exit.describe().c_str(),
-              secure_report.leaked_shm_files.size(), echo_exit.describe().c_str());
+  std::printf(
+      "lost: e2e %zu, secure e2e %zu, ping-pong %zu; service %s, %zu file(s) left in /dev/shm; secure "
+      "service %s, %zu file(s); echo %s\n",
+      e2e.lost, secure.lost, ping.lost, service_report.exit.describe().c_str(), service_report.leaked_shm_files.size(),
+      secure_report.exit.describe().c_str(), secure_report.leaked_shm_files.size(), echo_exit.describe().c_str());
   const bool clean = e2e.lost == 0 && secure.lost == 0 && ping.lost == 0 && service_report.clean() &&
                      secure_report.clean() && echo_exit.clean();
   return clean ? 0 : 1;

@@ -26,8 +26,7 @@ class DomainParticipantQos;
 namespace pullout::idl {
 
 // The file names expected in a credentials directory, in the order above.
-inline constexpr const char* kSecurityFiles[] = {"ca.pem", "cert.pem", "key.pem", "governance.p7s",
-                                                 "permissions.p7s"};
+inline constexpr const char* kSecurityFiles[] = {"ca.pem", "cert.pem", "key.pem", "governance.p7s", "permissions.p7s"};
 
 // Adds the dds.sec.* properties that enable the three plugins with the credentials in `dir` to
 // `qos`. Throws std::invalid_argument naming the first missing or unreadable file. Fast DDS
