@@ -70,7 +70,7 @@ Polyline::Polyline(const std::vector<Vec2>& points) {
 
 std::size_t Polyline::segment_at(double s) const {
   if (points_.size() < 2) return 0;
-  if (s <= 0.0) return 0;
+  if (!(s > 0.0)) return 0;  // also NaN: upper_bound would give the end, one past the last segment
   if (s >= s_.back()) return points_.size() - 2;
   const auto it = std::upper_bound(s_.begin(), s_.end(), s);
   return static_cast<std::size_t>(std::distance(s_.begin(), it)) - 1;

@@ -44,7 +44,7 @@ class Polyline {
   double s(std::size_t i) const { return s_[i]; }
   double length() const { return s_.empty() ? 0.0 : s_.back(); }
 
-  // Index of the segment [i, i+1] containing arc length s (clamped to the line).
+  // Index of the segment [i, i+1] containing arc length s (clamped to the line; NaN gives 0).
   std::size_t segment_at(double s) const;
   // Point at arc length s; beyond the ends the end segments are extended linearly.
   Vec2 point_at(double s) const;
