@@ -35,6 +35,7 @@
 #include <CLI/CLI.hpp>
 
 #include "fleet_client.hpp"
+#include "percentiles.hpp"
 #include "pullout/config/scenario.hpp"
 #include "service_process.hpp"
 
@@ -64,25 +65,8 @@ double rss_mb(pid_t pid) {
   return -1.0;
 }
 
-struct Summary {
-  std::size_t n{0};
-  double p50{0}, p99{0}, max{0};
-};
-
-Summary summarize(std::vector<double> v) {
-  Summary s;
-  s.n = v.size();
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  const auto rank = [&](double q) {
-    const auto k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
-    return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
-  };
-  s.p50 = rank(0.50);
-  s.p99 = rank(0.99);
-  s.max = v.back();
-  return s;
-}
+using pullout::bench::summarize;
+using pullout::bench::Summary;
 
 std::string load_text() {
   double load[3] = {0, 0, 0};

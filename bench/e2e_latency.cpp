@@ -51,6 +51,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "percentiles.hpp"
 #include "pullout/client/client.hpp"
 #include "pullout/config/config.hpp"
 #include "pullout/config/scenario.hpp"
@@ -86,27 +87,8 @@ double ms_since(SteadyClock::time_point t0) {
 // ------------------------------------------------------------------------------------------------
 // Statistics
 
-struct Summary {
-  std::size_t n{0};
-  double p50{0}, p90{0}, p99{0}, max{0};
-};
-
-// Nearest-rank percentiles.
-Summary summarize(std::vector<double> v) {
-  Summary s;
-  s.n = v.size();
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  const auto rank = [&](double q) {
-    const auto k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
-    return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
-  };
-  s.p50 = rank(0.50);
-  s.p90 = rank(0.90);
-  s.p99 = rank(0.99);
-  s.max = v.back();
-  return s;
-}
+using pullout::bench::summarize;
+using pullout::bench::Summary;
 
 void print_row(const std::string& what, const Summary& s) {
   std::printf("| %s | %zu | %.3f | %.3f | %.3f | %.3f |\n", what.c_str(), s.n, s.p50, s.p90, s.p99, s.max);
