@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "path_oracles.hpp"
 #include "pullout/geometry/polyline.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
@@ -209,23 +210,6 @@ double direction(const PathWithLaneId& seg) {
   return 0.0;
 }
 
-// Poses every 5 cm at most between consecutive points (position and heading linear).
-std::vector<Pose2> interpolated(const PathWithLaneId& seg) {
-  std::vector<Pose2> out;
-  for (std::size_t i = 0; i + 1 < seg.points.size(); ++i) {
-    const Pose2& a = seg.points[i].pose;
-    const Pose2& b = seg.points[i + 1].pose;
-    const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / 0.05)));
-    const double dyaw = std::remainder(b.yaw - a.yaw, 2.0 * kPi);
-    for (int k = 0; k < n; ++k) {
-      const double t = static_cast<double>(k) / n;
-      out.push_back({a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.yaw + t * dyaw});
-    }
-  }
-  if (!seg.points.empty()) out.push_back(seg.points.back().pose);
-  return out;
-}
-
 // The oracle's verdict on a found path; empty when it is drivable.
 std::string check_path(const PullOutPath& path, const Street& st, const VehicleInfo& v,
                        const StartPlannerParameters& p) {
@@ -252,7 +236,7 @@ std::string check_path(const PullOutPath& path, const Street& st, const VehicleI
   const double left = v.base_to_left_m();
   const double right = v.base_to_right_m();
   for (std::size_t i = 0; i < segs.size(); ++i) {
-    for (const Pose2& q : interpolated(segs[i])) {
+    for (const Pose2& q : oracle::poses_along(segs[i], 0.05)) {  // every 5 cm at most
       const Quad lanes_fp =
           rectangle(q.x, q.y, q.yaw, v.base_to_front_m() + m, v.base_to_rear_m() + m, left + m, right + m);
       for (const Vec2& c : lanes_fp) {
