@@ -248,6 +248,17 @@ class CycloneVehicles {
 
   const std::vector<StatusSeen>& statuses() const { return statuses_; }
 
+  // Waits until the status instance of some vehicle is no longer alive (the service evicted it);
+  // returns the vehicle ids seen so far.
+  std::vector<std::string> wait_status_gone(std::chrono::milliseconds timeout) {
+    const auto deadline = Clock::now() + timeout;
+    for (;;) {
+      drain();
+      if (!status_gone_.empty() || Clock::now() >= deadline) return status_gone_;
+      dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(100));
+    }
+  }
+
  private:
   dds_entity_t topic(const dds_topic_descriptor_t* type, const char* name) {
     return check(dds_create_topic(participant_, type, name, nullptr, nullptr), name);
@@ -291,8 +302,9 @@ class CycloneVehicles {
       const dds_return_t n = dds_take(status_reader_, samples, infos, kBatch, kBatch);
       if (n <= 0) break;
       for (dds_return_t i = 0; i < n; ++i) {
-        if (!infos[i].valid_data) continue;
         const auto* msg = static_cast<const pullout_msg_PullOutStatus*>(samples[i]);
+        if (infos[i].instance_state != DDS_IST_ALIVE) status_gone_.emplace_back(msg->vehicle_id);
+        if (!infos[i].valid_data) continue;
         statuses_.push_back(StatusSeen{msg->vehicle_id, msg->request_id, msg->state, msg->error});
       }
       dds_return_loan(status_reader_, samples, n);
@@ -307,6 +319,7 @@ class CycloneVehicles {
   dds_entity_t waitset_{0};
   std::vector<PathSeen> paths_;
   std::vector<StatusSeen> statuses_;
+  std::vector<std::string> status_gone_;
 };
 
 // ---- the fixture --------------------------------------------------------------------------------
@@ -318,7 +331,7 @@ class CycloneInterop : public ::testing::Test {
     ASSERT_EQ(::setenv("CYCLONEDDS_URI", ("file://" + config).c_str(), 1), 0);
     ServiceOptions options;
     options.executable = PULLOUT_SERVICE_EXE;
-    options.config_path = std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml";
+    options.config_path = service_config();
     service_.emplace(options);
     cyclone_.emplace(service_->domain());
     ASSERT_TRUE(cyclone_->wait_matched(kMatchTimeout))
@@ -332,6 +345,9 @@ class CycloneInterop : public ::testing::Test {
       EXPECT_TRUE(report.clean()) << report.describe() << "\nservice stderr:\n" << service_->stderr_tail();
     }
   }
+
+  // The service's configuration file (config/pullout.yaml unless a test needs another).
+  virtual std::string service_config() { return std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml"; }
 
   static bool is(const StatusSeen& s, pullout_msg_ExecutionState state) { return s.state == state; }
   static bool settled(const StatusSeen& s) { return s.state != pullout_msg_STATE_PLANNING; }
@@ -388,19 +404,64 @@ TEST_F(CycloneInterop, RequestPathStatusApprovalAndExecutingCrossVendors) {
 // request reader: Fast DDS NACKed the key-only sample for ever and held back every later sample of
 // that writer. Later requests, of another vehicle and of the same one, must still be answered.
 TEST_F(CycloneInterop, UnregisterAndDisposeDoNotHoldBackLaterRequests) {
-  expect_answered("cyclone-a", 1, "first request");
+  ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-a", 1, "first request"));
   {
     StraightShoulder a("cyclone-a", 1);
     ASSERT_EQ(dds_unregister_instance(cyclone_->request_writer(), &a.request), DDS_RETCODE_OK);
   }
-  expect_answered("cyclone-b", 2, "another vehicle after unregistering cyclone-a");
-  expect_answered("cyclone-a", 3, "the unregistered vehicle again");
+  ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-b", 2, "another vehicle after unregistering cyclone-a"));
+  ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-a", 3, "the unregistered vehicle again"));
   {
     StraightShoulder b("cyclone-b", 2);
     ASSERT_EQ(dds_dispose(cyclone_->request_writer(), &b.request), DDS_RETCODE_OK);
   }
-  expect_answered("cyclone-b", 4, "the disposed vehicle again");
-  expect_answered("cyclone-c", 5, "a new vehicle after a dispose");
+  ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-b", 4, "the disposed vehicle again"));
+  ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-c", 5, "a new vehicle after a dispose"));
+}
+
+// A service with room for two vehicles, so that a third one evicts one of them at once (the least
+// recently active idle one, or one whose vehicle is gone), with no timing involved.
+class CycloneInteropTwoVehicles : public CycloneInterop {
+ protected:
+  std::string service_config() override {
+    return dir_.write_file("pullout.yaml",
+                           "service:\n  max_vehicles: 2\n  session_idle_timeout_s: 600\ndds:\n"
+                           "  profiles_file: " PULLOUT_SOURCE_DIR "/config/dds/loopback.xml\n");
+  }
+};
+
+// Fast DDS 2.9.1 takes the instance of a Cyclone unregister or dispose from the wrong place: it
+// drops the serialized key that Cyclone sends (a key longer than 16 bytes) and computes the
+// instance from the last sample it deserialized, here vehicle B's request. The service then took
+// B as gone and evicted it (B lost its path and session, and its approval was ignored) while A
+// stayed. The service must not act on the instance state of a key-only sample from a writer that
+// is not Fast DDS's.
+TEST_F(CycloneInteropTwoVehicles, UnregisteringOneVehicleNeverEvictsAnother) {
+  const std::string a = "cyclone-vehicle-a";  // ids longer than 7 characters: a key of more than 16 bytes
+  const std::string b = "cyclone-vehicle-b";
+  ASSERT_NO_FATAL_FAILURE(expect_answered(a, 1, "vehicle A"));
+  ASSERT_NO_FATAL_FAILURE(expect_answered(b, 2, "vehicle B"));
+  {
+    StraightShoulder unregister(a, 1);
+    ASSERT_EQ(dds_unregister_instance(cyclone_->request_writer(), &unregister.request), DDS_RETCODE_OK);
+  }
+  // The service's reader has the unregister in its history once it acknowledged it, so the
+  // service takes it before the next request (its reader hands out samples by instance, not in
+  // arrival order, when several are waiting).
+  ASSERT_EQ(dds_wait_for_acks(cyclone_->request_writer(), DDS_SECS(10)), DDS_RETCODE_OK);
+  // A third vehicle takes the place of one of the two, at once when its request is taken (A, the
+  // least recently active). Never B's.
+  ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-vehicle-c", 3, "vehicle C in a full service"));
+
+  std::optional<PathSeen> path = cyclone_->wait_path(b, 2, kReplyTimeout);
+  ASSERT_TRUE(path.has_value());
+  const pullout_msg_Pose start = path->start_pose;
+  const auto executing = cyclone_->wait_status(
+      b, 2, [](const StatusSeen& s) { return is(s, pullout_msg_STATE_EXECUTING); }, kReplyTimeout,
+      [&] { cyclone_->send_progress(b, 2, start, true); });
+  ASSERT_TRUE(executing.has_value()) << "vehicle B approved its path but never became executing (evicted in A's "
+                                        "place?)\n"
+                                     << service_->stderr_tail();
 }
 
 }  // namespace

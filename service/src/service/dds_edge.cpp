@@ -3,9 +3,11 @@
 #include <exception>
 
 #include <cstring>
+#include <deque>
 #include <set>
 #include <utility>
 
+#include <fastdds/rtps/builtin/data/ParticipantProxyData.h>
 #include <fastdds/rtps/builtin/data/ReaderProxyData.h>
 #include <fastdds/rtps/builtin/data/WriterProxyData.h>
 #include <fastdds/rtps/common/InstanceHandle.h>
@@ -110,17 +112,22 @@ void check_endpoint_qos(const char* profile, const Qos& qos, dds::DurabilityQosP
 // Remembers the partitions of every remote writer the participant discovers (with security, the
 // access control plugin has checked them against the writer's permissions before the match).
 //
+// It also remembers the participants of other DDS vendors (by the vendor id of their discovery
+// data): Fast DDS 2.9.1 cannot tell which instance their unregister or dispose names
+// (instance_state_trusted).
+//
 // It also notes the partition of every remote path or status reader (a vehicle's: access control
 // has checked that its permissions grant that partition), so that the dispatcher creates that
 // vehicle's writers before its first reply (its client waits for them to match).
 class DdsEdge::Discovery final : public dds::DomainParticipantListener {
  public:
-  explicit Discovery(dds::GuardCondition& wake) : wake_(wake) {}
+  // track_partitions: secure mode (the partitions of readers and writers matter only there).
+  Discovery(dds::GuardCondition& wake, bool track_partitions) : wake_(wake), track_partitions_(track_partitions) {}
 
   void on_subscriber_discovery(dds::DomainParticipant* /*participant*/,
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::ReaderDiscoveryInfo;
-    if (info.status == Status::REMOVED_READER) return;
+    if (!track_partitions_ || info.status == Status::REMOVED_READER) return;
     const std::string topic = info.info.topicName().to_string();
     if (topic != kPathTopic && topic != kStatusTopic) return;
     const auto& names = info.info.m_qos.m_partition.names();
@@ -142,6 +149,7 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   void on_publisher_discovery(dds::DomainParticipant* /*participant*/,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo;
+    if (!track_partitions_) return;
     const auto& guid = info.info.guid();
     std::lock_guard<std::mutex> lock(mutex_);
     if (info.status == Status::REMOVED_WRITER) {
@@ -149,6 +157,30 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
       return;
     }
     partitions_[guid] = info.info.m_qos.m_partition.names();
+  }
+
+  void on_participant_discovery(dds::DomainParticipant* /*participant*/,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+    if (info.status != Status::DISCOVERED_PARTICIPANT) return;
+    if (info.info.m_VendorId == eprosima::fastrtps::rtps::c_VendorId_eProsima) return;
+    const auto& prefix = info.info.m_guid.guidPrefix;
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Kept after the participant leaves: a sample of its writers may still be waiting in a
+    // reader. Bounded: the oldest are forgotten first.
+    if (!foreign_.insert(prefix).second) return;
+    foreign_order_.push_back(prefix);
+    if (foreign_order_.size() > kMaxForeignParticipants) {
+      foreign_.erase(foreign_order_.front());
+      foreign_order_.pop_front();
+    }
+  }
+
+  // Whether the writer with this handle belongs to a participant of another DDS vendor.
+  bool foreign_writer(const eprosima::fastrtps::rtps::InstanceHandle_t& handle) const {
+    const auto guid = eprosima::fastrtps::rtps::iHandle2GUID(handle);
+    std::lock_guard<std::mutex> lock(mutex_);
+    return foreign_.count(guid.guidPrefix) != 0;
   }
 
   // Whether the writer with this handle is known and its partitions are exactly {name}.
@@ -162,10 +194,14 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
  private:
   // Bounds the set between two dispatcher wake-ups (only authenticated participants add to it).
   static constexpr std::size_t kMaxPendingVehicles = 65536;
+  static constexpr std::size_t kMaxForeignParticipants = 65536;
   dds::GuardCondition& wake_;
+  const bool track_partitions_;
   mutable std::mutex mutex_;
   std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> partitions_;
   std::set<std::string> pending_readers_;
+  std::set<eprosima::fastrtps::rtps::GuidPrefix_t> foreign_;
+  std::deque<eprosima::fastrtps::rtps::GuidPrefix_t> foreign_order_;
 };
 
 DdsEdge::DdsEdge(const DdsConfig& config) {
@@ -188,6 +224,9 @@ void DdsEdge::create_entities(const DdsConfig& config) {
     throw DdsSetupError("cannot load DDS profiles file " + config.profiles_file);
   }
   secure_ = !config.security_dir.empty();
+  // The discovery callbacks are not masked by the StatusMask: none keeps every other status
+  // (data available, matches) off the listener, on the dispatcher's wait set.
+  discovery_ = std::make_unique<Discovery>(discovery_wake_, secure_);
   if (secure_) {
     dds::DomainParticipantQos qos;
     if (factory->get_participant_qos_from_profile(config.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
@@ -198,7 +237,6 @@ void DdsEdge::create_entities(const DdsConfig& config) {
     } catch (const std::invalid_argument& e) {
       throw DdsSetupError(std::string("dds.security_dir: ") + e.what());
     }
-    discovery_ = std::make_unique<Discovery>(discovery_wake_);
     participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
     if (participant_ == nullptr) {
       throw DdsSetupError("cannot create the secure DDS participant with the credentials in " + config.security_dir +
@@ -206,7 +244,8 @@ void DdsEdge::create_entities(const DdsConfig& config) {
                           std::to_string(config.domain_id) + "): see the SECURITY errors of Fast DDS above");
     }
   } else {
-    participant_ = factory->create_participant_with_profile(config.domain_id, config.participant_profile);
+    participant_ = factory->create_participant_with_profile(config.domain_id, config.participant_profile,
+                                                            discovery_.get(), dds::StatusMask::none());
     if (participant_ == nullptr) {
       throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
                           config.profiles_file + " on domain " + std::to_string(config.domain_id));
@@ -299,6 +338,10 @@ void DdsEdge::prepare_discovered_vehicles() {
   for (const std::string& vehicle_id : discovery_->take_pending()) {
     if (writer_for(vehicle_id, true) != nullptr) spdlog::debug("vehicle '{}': writers ready", vehicle_id);
   }
+}
+
+bool DdsEdge::instance_state_trusted(const dds::SampleInfo& info) const {
+  return info.valid_data || !discovery_->foreign_writer(info.publication_handle);
 }
 
 bool DdsEdge::sender_may_act_for(const dds::SampleInfo& info, const std::string& vehicle_id) const {

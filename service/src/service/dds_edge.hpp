@@ -91,6 +91,12 @@ class DdsEdge final : public Outbox {
   // security; with security only a writer whose partitions are exactly {vehicle_id}. A sample
   // from a writer not (yet) discovered is refused. Thread-safe.
   bool sender_may_act_for(const eprosima::fastdds::dds::SampleInfo& info, const std::string& vehicle_id) const;
+  // Whether the instance of a sample (its SampleInfo) is the one its writer meant. Not for the
+  // key-only sample (unregister, dispose) of a writer of another DDS vendor: Fast DDS 2.9.1 drops
+  // the serialized key such a writer sends (or reads up to 16 bytes of it as a key hash) and then
+  // takes the instance of the last sample the reader deserialized, another vehicle's. Writers of
+  // Fast DDS send the key hash, which is right. Thread-safe.
+  bool instance_state_trusted(const eprosima::fastdds::dds::SampleInfo& info) const;
   // Secure mode: triggered when a vehicle's reader is discovered; the dispatcher then calls
   // prepare_discovered_vehicles (which creates that vehicle's writers and resets the trigger).
   eprosima::fastdds::dds::GuardCondition& discovery_condition() { return discovery_wake_; }
@@ -101,7 +107,7 @@ class DdsEdge final : public Outbox {
   eprosima::fastdds::dds::DataReader& progress_reader() { return *progress_reader_; }
 
  private:
-  class Discovery;  // the participant listener: the partitions of every discovered writer
+  class Discovery;  // the participant listener: discovered writers' partitions, other vendors' participants
   // One vehicle's writers in secure mode, in a publisher whose partition is the vehicle id.
   struct VehicleWriters {
     eprosima::fastdds::dds::Publisher* publisher{nullptr};

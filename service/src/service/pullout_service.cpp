@@ -195,6 +195,13 @@ bool PulloutService::sender_allowed(const dds::SampleInfo& info, const std::stri
 
 void PulloutService::instance_gone(InstanceNames& names, const dds::SampleInfo& info, VehicleInput input) {
   if (info.instance_state == dds::ALIVE_INSTANCE_STATE) return;
+  // An unregister or dispose from another DDS vendor may name the wrong instance (DdsEdge::
+  // instance_state_trusted): such a vehicle is evicted when idle for the timeout, or for room.
+  if (!dds_.instance_state_trusted(info)) {
+    spdlog::debug("{} instance state from a writer of another DDS vendor ignored",
+                  input == VehicleInput::kRequest ? kRequestTopic : kProgressTopic);
+    return;
+  }
   const auto it = names.find(info.instance_handle);
   if (it == names.end()) return;
   // With security, only the vehicle's own writers can end its instances (a dispose written by
