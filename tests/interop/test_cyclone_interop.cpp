@@ -14,8 +14,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -363,6 +365,8 @@ class CycloneInterop : public ::testing::Test {
     EXPECT_EQ(status->state, pullout_msg_STATE_WAITING_APPROVAL) << context << ": " << status->error;
   }
 
+  void unregister_and_dispose_then_request();
+
   TempDir dir_;
   std::optional<ServiceProcess> service_;
   std::optional<CycloneVehicles> cyclone_;
@@ -403,7 +407,7 @@ TEST_F(CycloneInterop, RequestPathStatusApprovalAndExecutingCrossVendors) {
 // A Cyclone writer that unregisters or disposes a request instance used to stall the service's
 // request reader: Fast DDS NACKed the key-only sample for ever and held back every later sample of
 // that writer. Later requests, of another vehicle and of the same one, must still be answered.
-TEST_F(CycloneInterop, UnregisterAndDisposeDoNotHoldBackLaterRequests) {
+void CycloneInterop::unregister_and_dispose_then_request() {
   ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-a", 1, "first request"));
   {
     StraightShoulder a("cyclone-a", 1);
@@ -417,6 +421,35 @@ TEST_F(CycloneInterop, UnregisterAndDisposeDoNotHoldBackLaterRequests) {
   }
   ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-b", 4, "the disposed vehicle again"));
   ASSERT_NO_FATAL_FAILURE(expect_answered("cyclone-c", 5, "a new vehicle after a dispose"));
+}
+
+TEST_F(CycloneInterop, UnregisterAndDisposeDoNotHoldBackLaterRequests) {
+  ASSERT_NO_FATAL_FAILURE(unregister_and_dispose_then_request());
+}
+
+// The same with profiles whose readers ask for DYNAMIC_REUSABLE (what config/dds/*.xml had before
+// they were changed): the service must not create a reader that stalls.
+class CycloneInteropDynamicReaders : public CycloneInterop {
+ protected:
+  std::string service_config() override {
+    std::ifstream in(std::string(PULLOUT_SOURCE_DIR) + "/config/dds/loopback.xml");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string xml = text.str();
+    const std::string from = "<historyMemoryPolicy>PREALLOCATED_WITH_REALLOC</historyMemoryPolicy>";
+    const std::string to = "<historyMemoryPolicy>DYNAMIC_REUSABLE</historyMemoryPolicy>";
+    int replaced = 0;
+    for (auto at = xml.find(from); at != std::string::npos; at = xml.find(from, at + to.size()), ++replaced) {
+      xml.replace(at, from.size(), to);
+    }
+    EXPECT_EQ(replaced, 4) << "the four readers of loopback.xml";
+    const std::string profiles = dir_.write_file("dynamic.xml", xml);
+    return dir_.write_file("pullout.yaml", "dds:\n  profiles_file: " + profiles + "\n");
+  }
+};
+
+TEST_F(CycloneInteropDynamicReaders, UnregisterAndDisposeDoNotHoldBackLaterRequests) {
+  ASSERT_NO_FATAL_FAILURE(unregister_and_dispose_then_request());
 }
 
 // A service with room for two vehicles, so that a third one evicts one of them at once (the least

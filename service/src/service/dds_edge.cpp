@@ -23,6 +23,7 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
@@ -269,12 +270,29 @@ void DdsEdge::create_entities(const DdsConfig& config) {
                          config.profiles_file + "?)");
   };
   // Readers and writers are created without listeners: samples are taken on the dispatcher thread.
-  request_reader_ = subscriber_->create_datareader_with_profile(request_topic_, kRequestReaderProfile, nullptr,
-                                                                dds::StatusMask::none());
-  if (request_reader_ == nullptr) throw missing_profile("request reader", kRequestReaderProfile);
-  progress_reader_ = subscriber_->create_datareader_with_profile(progress_topic_, kProgressReaderProfile, nullptr,
-                                                                 dds::StatusMask::none());
-  if (progress_reader_ == nullptr) throw missing_profile("progress reader", kProgressReaderProfile);
+  const auto reader = [&](dds::Topic* topic, const char* what, const char* profile) {
+    dds::DataReaderQos qos;
+    if (subscriber_->get_datareader_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK) {
+      throw missing_profile(what, profile);
+    }
+    // A Fast DDS 2.9.1 reader with a dynamic payload pool cannot take the empty payload of an
+    // unregister or dispose, NACKs it for ever and holds back every later sample of that writer
+    // (README, Interoperability): a profile that asks for one gets PREALLOCATED_WITH_REALLOC.
+    auto& policy = qos.endpoint().history_memory_policy;
+    if (policy == eprosima::fastrtps::rtps::DYNAMIC_RESERVE_MEMORY_MODE ||
+        policy == eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE) {
+      spdlog::warn(
+          "DDS profile {}: a DYNAMIC* history memory policy stalls the reader on unregister and dispose samples "
+          "(Fast DDS 2.9.1); using PREALLOCATED_WITH_REALLOC",
+          profile);
+      policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    }
+    dds::DataReader* created = subscriber_->create_datareader(topic, qos, nullptr, dds::StatusMask::none());
+    if (created == nullptr) throw missing_profile(what, profile);
+    return created;
+  };
+  request_reader_ = reader(request_topic_, "request reader", kRequestReaderProfile);
+  progress_reader_ = reader(progress_topic_, "progress reader", kProgressReaderProfile);
   // Writer-side filtering: the factory must be known before a reader is discovered.
   if (participant_->register_content_filter_factory(idl::kVehicleFilterClass, &filter_factory_) !=
       ReturnCode_t::RETCODE_OK) {
