@@ -11,11 +11,13 @@
 // before a negative check.
 #include <dds/dds.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -248,19 +250,6 @@ class CycloneVehicles {
     }
   }
 
-  const std::vector<StatusSeen>& statuses() const { return statuses_; }
-
-  // Waits until the status instance of some vehicle is no longer alive (the service evicted it);
-  // returns the vehicle ids seen so far.
-  std::vector<std::string> wait_status_gone(std::chrono::milliseconds timeout) {
-    const auto deadline = Clock::now() + timeout;
-    for (;;) {
-      drain();
-      if (!status_gone_.empty() || Clock::now() >= deadline) return status_gone_;
-      dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(100));
-    }
-  }
-
  private:
   dds_entity_t topic(const dds_topic_descriptor_t* type, const char* name) {
     return check(dds_create_topic(participant_, type, name, nullptr, nullptr), name);
@@ -276,6 +265,7 @@ class CycloneVehicles {
     void* samples[kBatch] = {};
     dds_sample_info_t infos[kBatch];
     for (;;) {
+      std::fill(std::begin(samples), std::end(samples), nullptr);  // null: Cyclone lends the samples
       const dds_return_t n = dds_take(path_reader_, samples, infos, kBatch, kBatch);
       if (n <= 0) break;
       for (dds_return_t i = 0; i < n; ++i) {
@@ -301,11 +291,11 @@ class CycloneVehicles {
       dds_return_loan(path_reader_, samples, n);
     }
     for (;;) {
+      std::fill(std::begin(samples), std::end(samples), nullptr);  // null: Cyclone lends the samples
       const dds_return_t n = dds_take(status_reader_, samples, infos, kBatch, kBatch);
       if (n <= 0) break;
       for (dds_return_t i = 0; i < n; ++i) {
         const auto* msg = static_cast<const pullout_msg_PullOutStatus*>(samples[i]);
-        if (infos[i].instance_state != DDS_IST_ALIVE) status_gone_.emplace_back(msg->vehicle_id);
         if (!infos[i].valid_data) continue;
         statuses_.push_back(StatusSeen{msg->vehicle_id, msg->request_id, msg->state, msg->error});
       }
@@ -321,7 +311,6 @@ class CycloneVehicles {
   dds_entity_t waitset_{0};
   std::vector<PathSeen> paths_;
   std::vector<StatusSeen> statuses_;
-  std::vector<std::string> status_gone_;
 };
 
 // ---- the fixture --------------------------------------------------------------------------------
@@ -354,8 +343,8 @@ class CycloneInterop : public ::testing::Test {
   static bool is(const StatusSeen& s, pullout_msg_ExecutionState state) { return s.state == state; }
   static bool settled(const StatusSeen& s) { return s.state != pullout_msg_STATE_PLANNING; }
 
-  // Sends the straight-shoulder request of `vehicle` and expects its found path and a
-  // waiting_approval status.
+  // Sends the straight-shoulder request of `vehicle` and expects its answer: a waiting_approval
+  // status (a path was found).
   void expect_answered(const std::string& vehicle, std::uint64_t request_id, const char* context) {
     StraightShoulder scenario(vehicle, request_id);
     ASSERT_TRUE(cyclone_->send(scenario.request)) << context;
