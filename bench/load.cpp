@@ -43,6 +43,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <iterator>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -72,6 +73,7 @@ constexpr auto kSetupTimeout = 90s;  // every worker's clients matched with the 
 constexpr auto kDrain = 5s;          // after the last send, for outstanding answers
 constexpr auto kIdleWindow = 2s;     // idle loopback traffic, measured before the send window
 constexpr auto kStartMargin = 1s;    // go -> first send
+constexpr integration::Millis kWorkerStopTimeout{5000};  // SIGTERM -> SIGKILL
 
 std::atomic<bool> g_stop{false};
 void on_signal(int /*signal*/) { g_stop.store(true); }
@@ -107,6 +109,9 @@ struct Answer {
   SteadyClock::time_point sent{};
   std::optional<SteadyClock::time_point> path_at;
   std::optional<SteadyClock::time_point> final_at;
+  std::int64_t sent_ns{0};       // system clock at send()
+  std::int64_t published_ns{0};  // the final status's stamp (the service's clock: same host)
+  std::int64_t arrived_ns{0};    // system clock when it arrived
   bool sent_by_us{false};
   bool found{false};
   bool waiting_approval{false};
@@ -139,6 +144,11 @@ int run_worker(const WorkerArgs& a) {
     po.domain_id = a.domain;
     participant.emplace(po);
   }
+  const auto t0 = SteadyClock::now();
+  const auto note = [&](const char* what) {
+    std::printf("%.2f s: %s\n", std::chrono::duration<double>(SteadyClock::now() - t0).count(), what);
+    std::fflush(stdout);
+  };
   std::vector<std::unique_ptr<VehicleState>> states;
   std::vector<std::unique_ptr<pullout::Client>> clients;
   for (int i = 0; i < a.count && !g_stop.load(); ++i) {
@@ -174,12 +184,15 @@ int run_worker(const WorkerArgs& a) {
       Answer& answer = s->answers[st.request_id];
       if (!answer.final_at) {
         answer.final_at = now;
+        answer.published_ns = st.stamp_ns;
+        answer.arrived_ns = system_ns();
         answer.waiting_approval = st.state == pullout::ExecutionState::kWaitingApproval;
       }
     });
     states.push_back(std::move(state));
     clients.push_back(std::move(client));
   }
+  note("clients created");
   const auto setup_deadline = SteadyClock::now() + kSetupTimeout;
   for (auto& client : clients) {
     if (g_stop.load()) return 3;
@@ -189,6 +202,7 @@ int run_worker(const WorkerArgs& a) {
       return 3;
     }
   }
+  note("clients matched");
   std::ofstream(a.dir + "/ready." + std::to_string(a.first)) << "ready\n";
 
   // The coordinator writes the start time (system clock ns) into the go file.
@@ -220,13 +234,16 @@ int run_worker(const WorkerArgs& a) {
       request.ego_pose.x = 6.0 + 24.0 * u;
       request.ego_pose.y = 3.0 + 0.4 * v;
       const auto sent = SteadyClock::now();
+      const std::int64_t sent_ns = system_ns();
       const std::uint64_t id = clients[i]->send(request);
       std::lock_guard<std::mutex> lock(states[i]->mutex);
       Answer& answer = states[i]->answers[id];
       answer.sent = sent;
+      answer.sent_ns = sent_ns;
       answer.sent_by_us = true;
     }
   }
+  note("sending done");
   // Drain: until everything is answered or kDrain.
   const auto drain_end = SteadyClock::now() + kDrain;
   while (!g_stop.load() && SteadyClock::now() < drain_end) {
@@ -255,14 +272,18 @@ int run_worker(const WorkerArgs& a) {
         latency = std::chrono::duration<double, std::milli>(std::max(*answer.path_at, *answer.final_at) - answer.sent)
                       .count();
       }
-      out << latency << ' ' << (answer.found && answer.waiting_approval ? 1 : 0) << '\n';
+      out << latency << ' ' << (answer.found && answer.waiting_approval ? 1 : 0) << ' '
+          << (answer.final_at ? static_cast<double>(answer.published_ns - answer.sent_ns) / 1e6 : -1.0) << ' '
+          << (answer.final_at ? static_cast<double>(answer.arrived_ns - answer.published_ns) / 1e6 : -1.0) << '\n';
     }
   }
   out << "mismatched " << mismatched << "\nmax_lag_ms " << max_lag_ms << '\n';
   out.close();
   std::filesystem::rename(a.dir + "/result." + std::to_string(a.first) + ".tmp",
                           a.dir + "/result." + std::to_string(a.first));
+  note("results written");
   clients.clear();
+  note("clients deleted");
   return 0;
 }
 
@@ -322,6 +343,27 @@ double vm_kb(pid_t pid, const std::string& key) {
   return -1.0;
 }
 
+// UDP datagrams dropped for a full receive buffer (RcvbufErrors in /proc/net/snmp: this network
+// namespace's counters).
+std::uint64_t udp_rcvbuf_errors() {
+  std::ifstream in("/proc/net/snmp");
+  std::string line;
+  std::vector<std::string> names;
+  while (std::getline(in, line)) {
+    if (line.rfind("Udp:", 0) != 0) continue;
+    std::istringstream fields(line.substr(4));
+    std::vector<std::string> values{std::istream_iterator<std::string>(fields), std::istream_iterator<std::string>()};
+    if (names.empty()) {
+      names = values;
+      continue;
+    }
+    for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) {
+      if (names[i] == "RcvbufErrors") return std::stoull(values[i]);
+    }
+  }
+  return 0;
+}
+
 std::string load_text() {
   double load[3] = {0, 0, 0};
   if (::getloadavg(load, 3) != 3) return "?";
@@ -358,6 +400,16 @@ int run_coordinator(const Options& o) {
 
   std::vector<std::unique_ptr<integration::ChildProcess>> workers;
   std::vector<int> firsts;
+  // On every exit: SIGTERM to all workers at once, then each is reaped (SIGKILL after a timeout).
+  struct StopWorkers {
+    std::vector<std::unique_ptr<integration::ChildProcess>>& workers;
+    ~StopWorkers() {
+      for (auto& w : workers) {
+        if (w->running()) ::kill(w->pid(), SIGTERM);
+      }
+      for (auto& w : workers) w->stop(kWorkerStopTimeout);
+    }
+  } stop_workers{workers};
   const auto setup_start = SteadyClock::now();
   for (int p = 0; p < o.processes; ++p) {
     const int first = o.vehicles * p / o.processes;
@@ -392,7 +444,12 @@ int run_coordinator(const Options& o) {
       }
     }
     if (g_stop.load() || SteadyClock::now() - setup_start > kSetupTimeout) {
-      throw std::runtime_error("the workers' clients did not all match the service in time");
+      std::string progress;
+      for (int first : firsts) {
+        progress += "\nworker " + std::to_string(first) + ":\n" +
+                    integration::read_file_tail(dir.path() + "/worker." + std::to_string(first) + ".out", 500);
+      }
+      throw std::runtime_error("the workers' clients did not all match the service in time" + progress);
     }
     std::this_thread::sleep_for(50ms);
   }
@@ -418,6 +475,7 @@ int run_coordinator(const Options& o) {
   std::uint64_t workers0 = 0;
   for (auto& w : workers) workers0 += cpu_ticks(w->pid());
   const auto machine0 = machine_jiffies();
+  const std::uint64_t drops0 = udp_rcvbuf_errors();
   const std::int64_t end_ns = start_ns + static_cast<std::int64_t>(o.duration * 1e9);
   if (!sleep_until_ns(end_ns)) throw std::runtime_error("stopped by a signal");
   const std::uint64_t bytes1 = count_bytes ? lo_tx_bytes() : 0;
@@ -425,22 +483,31 @@ int run_coordinator(const Options& o) {
   std::uint64_t workers1 = 0;
   for (auto& w : workers) workers1 += cpu_ticks(w->pid());
   const auto machine1 = machine_jiffies();
+  const std::uint64_t drops = udp_rcvbuf_errors() - drops0;
   const std::string load_after = load_text();
 
-  // Results: each worker exits after its drain.
-  const auto results_deadline = SteadyClock::now() + kDrain + 60s;
+  // Results: each worker writes its file after its drain (then deletes its clients).
+  const auto results_deadline = SteadyClock::now() + kDrain + 30s;
   for (std::size_t i = 0; i < workers.size(); ++i) {
-    const auto left = std::chrono::duration_cast<integration::Millis>(results_deadline - SteadyClock::now());
-    const auto exit = workers[i]->wait_exit(std::max(left, integration::Millis(1)));
-    if (!exit || !exit->clean()) {
-      throw std::runtime_error(
-          "worker " + std::to_string(firsts[i]) +
-          " did not finish cleanly: " + (exit ? exit->describe() : std::string("timeout")) + " " +
-          integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts[i]) + ".err", 2000));
+    const std::string file = dir.path() + "/result." + std::to_string(firsts[i]);
+    while (!std::filesystem::exists(file)) {
+      if (g_stop.load() || SteadyClock::now() > results_deadline || !workers[i]->running()) {
+        throw std::runtime_error("worker " + std::to_string(firsts[i]) + " wrote no result: " +
+                                 integration::read_file_tail(
+                                     dir.path() + "/worker." + std::to_string(firsts[i]) + ".out", 2000) +
+                                 integration::read_file_tail(
+                                     dir.path() + "/worker." + std::to_string(firsts[i]) + ".err", 2000));
+      }
+      std::this_thread::sleep_for(50ms);
     }
   }
+  std::printf("worker %d: %s", firsts.front(),
+              integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts.front()) + ".out", 2000)
+                  .c_str());
   const double hwm_mb = vm_kb(service_pid, "VmHWM") / 1024.0;
   std::vector<double> latencies;
+  std::vector<double> to_service_ms;    // send() -> the final status published
+  std::vector<double> from_service_ms;  // published -> arrived
   std::size_t sent = 0;
   std::size_t lost = 0;
   std::size_t not_planned = 0;
@@ -464,7 +531,13 @@ int run_coordinator(const Options& o) {
       } else if (!head.empty()) {
         const double latency = std::stod(head);
         int planned = 0;
-        fields >> planned;
+        double to_service = -1.0;
+        double from_service = -1.0;
+        fields >> planned >> to_service >> from_service;
+        if (to_service >= 0.0 || from_service >= 0.0) {
+          to_service_ms.push_back(to_service);
+          from_service_ms.push_back(from_service);
+        }
         ++sent;
         if (latency < 0) {
           ++lost;
@@ -491,8 +564,13 @@ int run_coordinator(const Options& o) {
     std::snprintf(buf, sizeof(buf), "%.0f", per_request);
     bytes_text = buf;
   }
-  std::printf("setup (all clients matched) %.1f s; load after: %s; max send lag %.1f ms\n\n", setup_s,
-              load_after.c_str(), max_lag_ms);
+  std::printf("setup (all clients matched) %.1f s; load after: %s; max send lag %.1f ms; UDP receive-buffer drops %llu%s\n",
+              setup_s, load_after.c_str(), max_lag_ms, static_cast<unsigned long long>(drops),
+              count_bytes ? "" : " (host-wide)");
+  const pullout::bench::Summary to = pullout::bench::summarize(to_service_ms);
+  const pullout::bench::Summary from = pullout::bench::summarize(from_service_ms);
+  std::printf("send -> final status published: p50 %.2f p99 %.2f ms; published -> arrived: p50 %.2f p99 %.2f ms\n\n",
+              to.p50, to.p99, from.p50, from.p99);
   std::printf(
       "| vehicles | processes | participants | rate [Hz] | sent | replies/s | p50 [ms] | p99 [ms] | max [ms] | lost | "
       "mismatched | not planned | service CPU [%% core] | service peak RSS [MB] | workers CPU [%% core] | machine busy "
@@ -503,7 +581,10 @@ int run_coordinator(const Options& o) {
       static_cast<double>(latencies.size()) / o.duration, s.p50, s.p99, s.max, lost, mismatched, not_planned,
       service_cpu, hwm_mb, workers_cpu, machine_busy, bytes_text.c_str());
 
-  workers.clear();
+  for (auto& w : workers) {
+    if (w->running()) ::kill(w->pid(), SIGTERM);
+  }
+  for (auto& w : workers) w->stop(kWorkerStopTimeout);
   const integration::StopReport report = service.stop();
   if (!report.clean()) std::printf("service stop: %s\n", report.describe().c_str());
   // Anything this run left in /dev/shm and no live process holds.
