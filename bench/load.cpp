@@ -43,8 +43,8 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <iterator>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -69,10 +69,10 @@ using SteadyClock = std::chrono::steady_clock;
 using SystemClock = std::chrono::system_clock;
 using namespace std::chrono_literals;
 
-constexpr auto kSetupTimeout = 90s;  // every worker's clients matched with the service
-constexpr auto kDrain = 5s;          // after the last send, for outstanding answers
-constexpr auto kIdleWindow = 2s;     // idle loopback traffic, measured before the send window
-constexpr auto kStartMargin = 1s;    // go -> first send
+constexpr auto kSetupTimeout = 90s;                      // every worker's clients matched with the service
+constexpr auto kDrain = 5s;                              // after the last send, for outstanding answers
+constexpr auto kIdleWindow = 2s;                         // idle loopback traffic, measured before the send window
+constexpr auto kStartMargin = 1s;                        // go -> first send
 constexpr integration::Millis kWorkerStopTimeout{5000};  // SIGTERM -> SIGKILL
 
 std::atomic<bool> g_stop{false};
@@ -492,18 +492,17 @@ int run_coordinator(const Options& o) {
     const std::string file = dir.path() + "/result." + std::to_string(firsts[i]);
     while (!std::filesystem::exists(file)) {
       if (g_stop.load() || SteadyClock::now() > results_deadline || !workers[i]->running()) {
-        throw std::runtime_error("worker " + std::to_string(firsts[i]) + " wrote no result: " +
-                                 integration::read_file_tail(
-                                     dir.path() + "/worker." + std::to_string(firsts[i]) + ".out", 2000) +
-                                 integration::read_file_tail(
-                                     dir.path() + "/worker." + std::to_string(firsts[i]) + ".err", 2000));
+        throw std::runtime_error(
+            "worker " + std::to_string(firsts[i]) + " wrote no result: " +
+            integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts[i]) + ".out", 2000) +
+            integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts[i]) + ".err", 2000));
       }
       std::this_thread::sleep_for(50ms);
     }
   }
-  std::printf("worker %d: %s", firsts.front(),
-              integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts.front()) + ".out", 2000)
-                  .c_str());
+  std::printf(
+      "worker %d: %s", firsts.front(),
+      integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts.front()) + ".out", 2000).c_str());
   const double hwm_mb = vm_kb(service_pid, "VmHWM") / 1024.0;
   std::vector<double> latencies;
   std::vector<double> to_service_ms;    // send() -> the final status published
@@ -564,9 +563,10 @@ int run_coordinator(const Options& o) {
     std::snprintf(buf, sizeof(buf), "%.0f", per_request);
     bytes_text = buf;
   }
-  std::printf("setup (all clients matched) %.1f s; load after: %s; max send lag %.1f ms; UDP receive-buffer drops %llu%s\n",
-              setup_s, load_after.c_str(), max_lag_ms, static_cast<unsigned long long>(drops),
-              count_bytes ? "" : " (host-wide)");
+  std::printf(
+      "setup (all clients matched) %.1f s; load after: %s; max send lag %.1f ms; UDP receive-buffer drops %llu%s\n",
+      setup_s, load_after.c_str(), max_lag_ms, static_cast<unsigned long long>(drops),
+      count_bytes ? "" : " (host-wide)");
   const pullout::bench::Summary to = pullout::bench::summarize(to_service_ms);
   const pullout::bench::Summary from = pullout::bench::summarize(from_service_ms);
   std::printf("send -> final status published: p50 %.2f p99 %.2f ms; published -> arrived: p50 %.2f p99 %.2f ms\n\n",
