@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -118,10 +119,61 @@ void push_bounded(std::deque<Received<T>>& queue, Received<T> item, std::size_t 
 
 }  // namespace
 
+namespace client_detail {
+
+// The DDS participant, its topics and the vehicle filter factory, shared by the Clients on it: one
+// per single-vehicle Client, or one per ClientParticipant. Each Client holds a shared_ptr, so the
+// participant is deleted after the last Client on it.
+class __attribute__((visibility("hidden"))) SharedParticipant {
+ public:
+  SharedParticipant(int domain_id, std::string profiles_file, const std::string& participant_profile,
+                    const std::string& security_dir);
+  ~SharedParticipant();
+  SharedParticipant(const SharedParticipant&) = delete;
+  SharedParticipant& operator=(const SharedParticipant&) = delete;
+
+  int domain_id() const { return domain_id_; }
+  const std::string& profiles_file() const { return profiles_file_; }
+  dds::DomainParticipant* participant() const { return participant_; }
+  dds::Topic* request_topic() const { return request_topic_; }
+  dds::Topic* progress_topic() const { return progress_topic_; }
+  dds::Topic* path_topic() const { return path_topic_; }
+  dds::Topic* status_topic() const { return status_topic_; }
+
+  // Registers a Client for vehicle_id; throws std::invalid_argument when one is already alive.
+  // Returns a serial that makes the Client's content-filtered topic names unique.
+  std::uint64_t claim(const std::string& vehicle_id);
+  void release(const std::string& vehicle_id);
+  std::size_t client_count() const;
+  // Serialises the creation and deletion of Clients' entities on the participant.
+  std::mutex& entities_mutex() { return entities_mutex_; }
+
+ private:
+  const int domain_id_;
+  const std::string profiles_file_;
+  // Registered with the participant: declared first (destroyed last).
+  void create(const std::string& participant_profile, const std::string& security_dir);
+  void destroy() noexcept;
+
+  idl::VehicleIdFilterFactory filter_factory_;
+  dds::DomainParticipant* participant_{nullptr};
+  dds::Topic* request_topic_{nullptr};
+  dds::Topic* progress_topic_{nullptr};
+  dds::Topic* path_topic_{nullptr};
+  dds::Topic* status_topic_{nullptr};
+  mutable std::mutex mutex_;
+  std::set<std::string> vehicles_;
+  std::uint64_t next_serial_{0};
+  std::mutex entities_mutex_;
+};
+
+}  // namespace client_detail
+
 // Hidden explicitly: a nested class inherits the default visibility of the exported Client.
 class __attribute__((visibility("hidden"))) Client::Impl {
  public:
-  explicit Impl(ClientOptions options);
+  // shared: the participant to create the client's endpoints on; null: a participant of its own.
+  Impl(std::shared_ptr<client_detail::SharedParticipant> shared, ClientOptions options);
   ~Impl();
 
   std::uint64_t send(PullOutRequest request);
@@ -145,7 +197,8 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   void destroy_entities() noexcept;
   dds::DataWriterQos writer_qos(const char* profile) const;
   dds::DataReaderQos reader_qos(const char* profile, int depth) const;
-  dds::DataReader* create_reply_reader(dds::Topic* topic, const char* profile, int depth);
+  dds::DataReader* create_reply_reader(dds::Topic* topic, const char* profile, int depth,
+                                       dds::ContentFilteredTopic** filter);
 
   void run();
   void dispatch_once();
@@ -170,12 +223,16 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   bool on_dispatcher_thread() const { return std::this_thread::get_id() == dispatcher_.get_id(); }
   void wake_dispatcher() { wake_.set_trigger_value(true); }
 
-  const ClientOptions options_;
+  ClientOptions options_;
 
-  // --- DDS entities: created in the constructor, deleted in the destructor. The filter factory is
-  // registered with the participant, so it is declared first (destroyed last). ---
-  idl::VehicleIdFilterFactory filter_factory_;
+  // --- DDS entities: created in the constructor, deleted in the destructor (the participant and
+  // topics with the last Client holding shared_). ---
+  std::shared_ptr<client_detail::SharedParticipant> shared_;
+  bool claimed_{false};  // shared_ has this vehicle registered
+  std::uint64_t serial_{0};
   dds::DomainParticipant* participant_{nullptr};
+  dds::ContentFilteredTopic* path_filter_{nullptr};
+  dds::ContentFilteredTopic* status_filter_{nullptr};
   dds::Publisher* publisher_{nullptr};
   dds::Subscriber* subscriber_{nullptr};
   dds::DataWriter* request_writer_{nullptr};
@@ -223,61 +280,62 @@ class __attribute__((visibility("hidden"))) Client::Impl {
 };
 
 // ------------------------------------------------------------------------------------------------
-// Construction and destruction
+// The shared participant
 
-Client::Impl::Impl(ClientOptions options) : options_(std::move(options)) {
-  validate_options(options_);
+namespace client_detail {
+
+SharedParticipant::SharedParticipant(int domain_id, std::string profiles_file, const std::string& participant_profile,
+                                     const std::string& security_dir)
+    : domain_id_(domain_id), profiles_file_(std::move(profiles_file)) {
   try {
-    create_entities();
-    dispatcher_ = std::thread([this] { run(); });
+    create(participant_profile, security_dir);
   } catch (...) {
-    destroy_entities();
+    destroy();
     throw;
   }
 }
 
-Client::Impl::~Impl() {
-  stop_.store(true);
-  wake_dispatcher();
-  if (dispatcher_.joinable()) dispatcher_.join();
-  state_cv_.notify_all();
-  destroy_entities();
+SharedParticipant::~SharedParticipant() { destroy(); }
+
+void SharedParticipant::destroy() noexcept {
+  if (participant_ == nullptr) return;
+  participant_->delete_contained_entities();
+  dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  participant_ = nullptr;
 }
 
-void Client::Impl::create_entities() {
+void SharedParticipant::create(const std::string& participant_profile, const std::string& security_dir) {
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::DomainParticipantQos participant_qos;
-  if (options_.profiles_file.empty()) {
+  if (profiles_file_.empty()) {
     participant_qos = client_detail::loopback_participant_qos();
   } else {
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(options_.profiles_file, ec)) {
-      throw ClientError("DDS profiles file '" + options_.profiles_file + "' does not exist or is not a file");
+    if (!std::filesystem::is_regular_file(profiles_file_, ec)) {
+      throw ClientError("DDS profiles file '" + profiles_file_ + "' does not exist or is not a file");
     }
     // Fast DDS only logs a broken file: check the result ourselves.
-    if (factory->load_XML_profiles_file(options_.profiles_file) != ReturnCode::RETCODE_OK) {
-      throw ClientError("DDS profiles file '" + options_.profiles_file + "' could not be loaded (invalid XML?)");
+    if (factory->load_XML_profiles_file(profiles_file_) != ReturnCode::RETCODE_OK) {
+      throw ClientError("DDS profiles file '" + profiles_file_ + "' could not be loaded (invalid XML?)");
     }
-    if (factory->get_participant_qos_from_profile(options_.participant_profile, participant_qos) !=
-        ReturnCode::RETCODE_OK) {
-      throw ClientError("participant profile '" + options_.participant_profile + "' not found in '" +
-                        options_.profiles_file + "'");
+    if (factory->get_participant_qos_from_profile(participant_profile, participant_qos) != ReturnCode::RETCODE_OK) {
+      throw ClientError("participant profile '" + participant_profile + "' not found in '" + profiles_file_ + "'");
     }
   }
-  const bool secure = !options_.security_dir.empty();
+  const bool secure = !security_dir.empty();
   if (secure) {
     try {
-      idl::add_security_properties(options_.security_dir, participant_qos);
+      idl::add_security_properties(security_dir, participant_qos);
     } catch (const std::invalid_argument& e) {
       throw ClientError(std::string("security_dir: ") + e.what());
     }
   }
-  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(options_.domain_id), participant_qos);
+  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id_), participant_qos);
   if (participant_ == nullptr) {
-    throw ClientError("cannot create a DDS participant on domain " + std::to_string(options_.domain_id) +
-                      (secure ? " with the credentials in " + options_.security_dir +
-                                    " (the reason is in Fast DDS's log, category SECURITY)"
-                              : std::string()));
+    throw ClientError(
+        "cannot create a DDS participant on domain " + std::to_string(domain_id_) +
+        (secure ? " with the credentials in " + security_dir + " (the reason is in Fast DDS's log, category SECURITY)"
+                : std::string()));
   }
   if (participant_->register_content_filter_factory(idl::kVehicleFilterClass, &filter_factory_) !=
       ReturnCode::RETCODE_OK) {
@@ -299,14 +357,85 @@ void Client::Impl::create_entities() {
   };
   // Guarded: a malformed reply fails to deserialize (and is dropped) instead of throwing out of
   // take_next_sample on the client's thread.
-  dds::Topic* request_topic = create_topic(client_detail::kRequestTopic,
-                                           register_type(idl::make_guarded_type<msg::PullOutRequestPubSubType>()));
-  dds::Topic* progress_topic = create_topic(client_detail::kProgressTopic,
-                                            register_type(idl::make_guarded_type<msg::ExecutionProgressPubSubType>()));
-  dds::Topic* path_topic =
+  request_topic_ = create_topic(client_detail::kRequestTopic,
+                                register_type(idl::make_guarded_type<msg::PullOutRequestPubSubType>()));
+  progress_topic_ = create_topic(client_detail::kProgressTopic,
+                                 register_type(idl::make_guarded_type<msg::ExecutionProgressPubSubType>()));
+  path_topic_ =
       create_topic(client_detail::kPathTopic, register_type(idl::make_guarded_type<msg::PullOutPathPubSubType>()));
-  dds::Topic* status_topic =
+  status_topic_ =
       create_topic(client_detail::kStatusTopic, register_type(idl::make_guarded_type<msg::PullOutStatusPubSubType>()));
+}
+
+std::uint64_t SharedParticipant::claim(const std::string& vehicle_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!vehicles_.insert(vehicle_id).second) {
+    throw std::invalid_argument("ClientOptions.vehicle_id: the participant already has a client for vehicle '" +
+                                vehicle_id + "'");
+  }
+  return ++next_serial_;
+}
+
+void SharedParticipant::release(const std::string& vehicle_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  vehicles_.erase(vehicle_id);
+}
+
+std::size_t SharedParticipant::client_count() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return vehicles_.size();
+}
+
+}  // namespace client_detail
+
+// ------------------------------------------------------------------------------------------------
+// Construction and destruction
+
+Client::Impl::Impl(std::shared_ptr<client_detail::SharedParticipant> shared, ClientOptions options)
+    : options_(std::move(options)) {
+  if (shared) {
+    if (!options_.security_dir.empty()) {
+      throw std::invalid_argument(
+          "ClientOptions.security_dir: not supported on a shared ClientParticipant (credentials belong to a "
+          "participant)");
+    }
+    // The participant's: client.hpp says these fields are ignored on a shared participant.
+    options_.domain_id = shared->domain_id();
+    options_.profiles_file = shared->profiles_file();
+  }
+  validate_options(options_);
+  if (!shared) {
+    shared = std::make_shared<client_detail::SharedParticipant>(options_.domain_id, options_.profiles_file,
+                                                                options_.participant_profile, options_.security_dir);
+  }
+  serial_ = shared->claim(options_.vehicle_id);  // throws for a vehicle already on it
+  claimed_ = true;
+  shared_ = std::move(shared);
+  participant_ = shared_->participant();
+  try {
+    create_entities();
+    dispatcher_ = std::thread([this] { run(); });
+  } catch (...) {
+    destroy_entities();
+    throw;
+  }
+}
+
+Client::Impl::~Impl() {
+  stop_.store(true);
+  wake_dispatcher();
+  if (dispatcher_.joinable()) dispatcher_.join();
+  state_cv_.notify_all();
+  destroy_entities();
+}
+
+void Client::Impl::create_entities() {
+  std::lock_guard<std::mutex> lock(shared_->entities_mutex());
+  const bool secure = !options_.security_dir.empty();
+  dds::Topic* request_topic = shared_->request_topic();
+  dds::Topic* progress_topic = shared_->progress_topic();
+  dds::Topic* path_topic = shared_->path_topic();
+  dds::Topic* status_topic = shared_->status_topic();
 
   // With security, this vehicle's partition (the only one its permissions grant).
   dds::PublisherQos publisher_qos = dds::PUBLISHER_QOS_DEFAULT;
@@ -323,8 +452,9 @@ void Client::Impl::create_entities() {
   if (request_writer_ == nullptr) throw ClientError("cannot create the pullout/request writer");
   progress_writer_ = publisher_->create_datawriter(progress_topic, writer_qos(client_detail::kProgressWriterProfile));
   if (progress_writer_ == nullptr) throw ClientError("cannot create the pullout/progress writer");
-  path_reader_ = create_reply_reader(path_topic, client_detail::kPathReaderProfile, kPathReaderDepth);
-  status_reader_ = create_reply_reader(status_topic, client_detail::kStatusReaderProfile, kStatusReaderDepth);
+  path_reader_ = create_reply_reader(path_topic, client_detail::kPathReaderProfile, kPathReaderDepth, &path_filter_);
+  status_reader_ =
+      create_reply_reader(status_topic, client_detail::kStatusReaderProfile, kStatusReaderDepth, &status_filter_);
   path_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
                                                            << dds::StatusMask::subscription_matched());
   status_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
@@ -333,13 +463,15 @@ void Client::Impl::create_entities() {
   progress_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
 }
 
-dds::DataReader* Client::Impl::create_reply_reader(dds::Topic* topic, const char* profile, int depth) {
+dds::DataReader* Client::Impl::create_reply_reader(dds::Topic* topic, const char* profile, int depth,
+                                                   dds::ContentFilteredTopic** filter) {
   const std::string topic_name = topic->get_name();
-  // The name only has to be unique within this participant (one per client).
-  dds::ContentFilteredTopic* filtered =
-      participant_->create_contentfilteredtopic(topic_name + "/this_vehicle", topic, idl::kVehicleFilterExpression,
-                                                {options_.vehicle_id}, idl::kVehicleFilterClass);
+  // The name only has to be unique within the participant (serial_: one per client on it).
+  dds::ContentFilteredTopic* filtered = participant_->create_contentfilteredtopic(
+      topic_name + "/vehicle_" + std::to_string(serial_), topic, idl::kVehicleFilterExpression, {options_.vehicle_id},
+      idl::kVehicleFilterClass);
   if (filtered == nullptr) throw ClientError("cannot create the vehicle filter on " + topic_name);
+  *filter = filtered;
   dds::DataReader* reader = subscriber_->create_datareader(filtered, reader_qos(profile, depth));
   if (reader == nullptr) throw ClientError("cannot create the " + topic_name + " reader");
   return reader;
@@ -368,15 +500,33 @@ dds::DataReaderQos Client::Impl::reader_qos(const char* profile, int depth) cons
 }
 
 void Client::Impl::destroy_entities() noexcept {
-  if (participant_ == nullptr) return;
-  // Deletes readers before their content-filtered topics, then the topics.
-  participant_->delete_contained_entities();
-  dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
-  participant_ = nullptr;
+  if (!shared_) return;
+  {
+    // Only this client's entities: the other clients on the participant keep theirs. Readers
+    // before their content-filtered topics.
+    std::lock_guard<std::mutex> lock(shared_->entities_mutex());
+    if (subscriber_ != nullptr) {
+      if (path_reader_ != nullptr) subscriber_->delete_datareader(path_reader_);
+      if (status_reader_ != nullptr) subscriber_->delete_datareader(status_reader_);
+      participant_->delete_subscriber(subscriber_);
+    }
+    if (path_filter_ != nullptr) participant_->delete_contentfilteredtopic(path_filter_);
+    if (status_filter_ != nullptr) participant_->delete_contentfilteredtopic(status_filter_);
+    if (publisher_ != nullptr) {
+      if (request_writer_ != nullptr) publisher_->delete_datawriter(request_writer_);
+      if (progress_writer_ != nullptr) publisher_->delete_datawriter(progress_writer_);
+      participant_->delete_publisher(publisher_);
+    }
+  }
   publisher_ = nullptr;
   subscriber_ = nullptr;
   request_writer_ = progress_writer_ = nullptr;
   path_reader_ = status_reader_ = nullptr;
+  path_filter_ = status_filter_ = nullptr;
+  if (claimed_) shared_->release(options_.vehicle_id);
+  claimed_ = false;
+  participant_ = nullptr;
+  shared_.reset();  // the participant goes with its last client
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -773,7 +923,9 @@ bool Client::Impl::wait_for_service(Duration timeout) const {
 // ------------------------------------------------------------------------------------------------
 // Client: forwards to Impl
 
-Client::Client(ClientOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Client::Client(ClientOptions options) : impl_(std::make_unique<Impl>(nullptr, std::move(options))) {}
+Client::Client(ClientParticipant& participant, ClientOptions options)
+    : impl_(std::make_unique<Impl>(participant.shared_, std::move(options))) {}
 Client::~Client() = default;
 
 std::uint64_t Client::send(PullOutRequest request) { return impl_->send(std::move(request)); }
@@ -795,5 +947,22 @@ bool Client::wait_for_service(Duration timeout) const { return impl_->wait_for_s
 ServiceState Client::service_state() const { return impl_->service_state(); }
 const std::string& Client::vehicle_id() const { return impl_->options().vehicle_id; }
 int Client::domain_id() const { return impl_->options().domain_id; }
+
+// ------------------------------------------------------------------------------------------------
+// ClientParticipant
+
+ClientParticipant::ClientParticipant(ClientParticipantOptions options) {
+  if (options.domain_id < 0 || options.domain_id > kMaxDomainId) {
+    throw std::invalid_argument("ClientParticipantOptions.domain_id: " + std::to_string(options.domain_id) +
+                                " is outside 0.." + std::to_string(kMaxDomainId));
+  }
+  shared_ = std::make_shared<client_detail::SharedParticipant>(options.domain_id, std::move(options.profiles_file),
+                                                               options.participant_profile, std::string());
+}
+
+ClientParticipant::~ClientParticipant() = default;
+
+int ClientParticipant::domain_id() const { return shared_->domain_id(); }
+std::size_t ClientParticipant::client_count() const { return shared_->client_count(); }
 
 }  // namespace pullout

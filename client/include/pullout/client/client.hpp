@@ -56,11 +56,30 @@
 // then deletes every DDS entity. Do not destroy a Client from one of its callbacks, nor while
 // another thread is inside one of its member functions.
 //
+// Many vehicles on one participant (a vehicle gateway, a fleet simulator). A ClientParticipant owns
+// one DDS participant and the four topics; Clients constructed on it (Client(participant,
+// options)) each speak for their own vehicle as above, with their own request and progress writers
+// and their own vehicle-filtered path and status readers, the same re-sending, service state,
+// waits and callbacks, but no participant of their own: discovery traffic, sockets and the
+// participant's threads are paid once per participant instead of once per vehicle (one
+// participant per vehicle stops working at about 200 vehicles per process on a 2-core machine;
+// bench/RESULTS.md, "Load"). Each Client still has its own delivery thread. On a shared
+// participant, the domain, profiles file and participant profile are the participant's (the
+// corresponding ClientOptions fields are ignored) and security_dir must be empty (DDS Security
+// credentials belong to a participant, and a vehicle's permissions grant only its own id).
+// At most one Client per vehicle id is alive on a participant at a time. Constructing and
+// destroying Clients on one participant from several threads at once is allowed.
+// Lifetime: a ClientParticipant must outlive the Clients constructed on it (a Client keeps the
+// DDS participant alive anyway, so a violation leaks nothing: the DDS participant is deleted
+// with the last of them). Destroying a Client deletes only its own endpoints; the other Clients
+// on the participant are not disturbed.
+//
 // Units and frames are those of pullout/model/types.hpp. The public headers of this library
 // include no DDS header.
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -95,6 +114,20 @@ struct ClientOptions {
   std::chrono::milliseconds resend_window{10000};
 };
 
+// A DDS participant shared by many Clients (see "Many vehicles on one participant" above).
+struct ClientParticipantOptions {
+  // DDS domain, 0..232. The service must use the same domain.
+  int domain_id{0};
+  // Fast DDS XML profiles file. Empty: built-in loopback-only defaults (see "DDS setup" above).
+  std::string profiles_file;
+  // Participant profile in profiles_file (ignored when profiles_file is empty).
+  std::string participant_profile{"pullout_participant"};
+};
+
+namespace client_detail {
+class SharedParticipant;
+}  // namespace client_detail
+
 // The client's view of the service (see "Re-sending and a lost service" above).
 enum class ServiceState {
   kNotFound,   // never matched since the client was created
@@ -109,6 +142,27 @@ class PULLOUT_CLIENT_EXPORT ClientError : public std::runtime_error {
   explicit ClientError(const std::string& what);
 };
 
+class PULLOUT_CLIENT_EXPORT ClientParticipant {
+ public:
+  // Creates the participant and the topics. Throws std::invalid_argument for a bad domain_id and
+  // ClientError when DDS cannot be set up (the message names what failed).
+  explicit ClientParticipant(ClientParticipantOptions options);
+  ~ClientParticipant();
+
+  ClientParticipant(const ClientParticipant&) = delete;
+  ClientParticipant& operator=(const ClientParticipant&) = delete;
+  ClientParticipant(ClientParticipant&&) = delete;
+  ClientParticipant& operator=(ClientParticipant&&) = delete;
+
+  int domain_id() const;
+  // Clients alive on this participant.
+  std::size_t client_count() const;
+
+ private:
+  friend class Client;
+  std::shared_ptr<client_detail::SharedParticipant> shared_;
+};
+
 class PULLOUT_CLIENT_EXPORT Client {
  public:
   using PathCallback = std::function<void(const PullOutPath&)>;
@@ -120,6 +174,10 @@ class PULLOUT_CLIENT_EXPORT Client {
   // wait_for_service). Throws std::invalid_argument for a bad vehicle_id or domain_id, and
   // ClientError when DDS cannot be set up (the message names what failed).
   explicit Client(ClientOptions options);
+  // A client on a shared participant (see "Many vehicles on one participant" above): creates this
+  // vehicle's readers and writers on it. Throws as above, and std::invalid_argument when the
+  // participant already has a Client for options.vehicle_id or options.security_dir is set.
+  Client(ClientParticipant& participant, ClientOptions options);
   ~Client();
 
   Client(const Client&) = delete;

@@ -1,0 +1,673 @@
+// Load: N simulated vehicles, real pullout::Clients spread over several processes, against one
+// pullout_service on loopback, bounded in time.
+//
+//   bench_load [--vehicles 1000] [--processes 4] [--rate 1] [--duration 30]
+//              [--participant-per-vehicle] [--no-netns] [--service PATH] [--config FILE]
+//
+// On a DDS domain leased for the run: the real pullout_service (config/pullout.yaml with
+// config/dds/loopback.xml) and `processes` worker processes (this binary with --worker), each
+// with its share of the vehicles as pullout::Clients on one shared pullout::ClientParticipant
+// (--participant-per-vehicle: one participant per vehicle, the single-vehicle constructor, for
+// comparison). Once every client matched the service, each vehicle sends a straight_shoulder
+// request `rate` times a second for `duration` seconds, its start pose varied per vehicle and per
+// request (x in [6, 30] m, y in [3.0, 3.4] m: real plans), the vehicles' phases spread evenly over
+// the period. A request is answered when its path and a status past planning have arrived
+// (latency = send() -> the later of the two, in the worker's callbacks); planned when that path is
+// found and the status waits for approval. After the last send the workers wait kDrain for
+// outstanding answers; what is still unanswered is lost. A reply whose vehicle id is not the
+// client's, or whose request id that vehicle never sent, is mismatched. Lost and mismatched must
+// be 0.
+//
+// Reported: replies/s (answered requests / duration), latency p50/p99/max, lost, mismatched, not
+// planned; the service's CPU over the send window (/proc/PID/stat, % of one core) and peak RSS
+// (VmHWM); the workers' CPU; the machine's CPU busy share (/proc/stat); the workers' largest lag
+// behind their send schedule (a lag means the clients, not the service, are the limit); loopback
+// bytes per request. As root the bench re-runs itself in a network namespace of its own (as
+// bench_fleet_bytes: `ip netns add pullout-load-<pid>`, lo up, deleted at the end), so lo's
+// tx_bytes counts only this run: bytes per request = (window bytes - idle rate x window) / sent.
+// Without root (or with --no-netns) that figure is n/a.
+//
+// Bounded: matching kSetupTimeout, then duration + kDrain; the workers and the service are
+// stopped by PID (SIGTERM, then SIGKILL) on exit, on SIGINT/SIGTERM and on failure, and any
+// /dev/shm file this run left is removed. Prints one markdown row; results go to bench/RESULTS.md.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "percentiles.hpp"
+#include "pullout/client/client.hpp"
+#include "pullout/config/scenario.hpp"
+#include "service_process.hpp"
+
+namespace {
+
+namespace integration = pullout::integration;
+using SteadyClock = std::chrono::steady_clock;
+using SystemClock = std::chrono::system_clock;
+using namespace std::chrono_literals;
+
+constexpr auto kSetupTimeout = 90s;                      // every worker's clients matched with the service
+constexpr auto kDrain = 5s;                              // after the last send, for outstanding answers
+constexpr auto kIdleWindow = 2s;                         // idle loopback traffic, measured before the send window
+constexpr auto kStartMargin = 1s;                        // go -> first send
+constexpr integration::Millis kWorkerStopTimeout{5000};  // SIGTERM -> SIGKILL
+
+std::atomic<bool> g_stop{false};
+void on_signal(int /*signal*/) { g_stop.store(true); }
+
+std::string source_path(const std::string& relative) { return std::string(PULLOUT_SOURCE_DIR) + "/" + relative; }
+
+std::string self_exe() {
+  char self[4096];
+  const ssize_t len = ::readlink("/proc/self/exe", self, sizeof(self) - 1);
+  if (len <= 0) throw std::runtime_error("cannot find this executable");
+  self[len] = '\0';
+  return self;
+}
+
+std::int64_t system_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(SystemClock::now().time_since_epoch()).count();
+}
+
+// Sleeps until `t` (system clock ns) in short steps; false when stopped by a signal.
+bool sleep_until_ns(std::int64_t t) {
+  while (!g_stop.load()) {
+    const std::int64_t left = t - system_ns();
+    if (left <= 0) return true;
+    std::this_thread::sleep_for(std::chrono::nanoseconds(std::min<std::int64_t>(left, 50'000'000)));
+  }
+  return false;
+}
+
+// ------------------------------------------------------------------------------------------------
+// Worker: its vehicles on one participant, sending on schedule, recording answers.
+
+struct Answer {
+  SteadyClock::time_point sent{};
+  std::optional<SteadyClock::time_point> path_at;
+  std::optional<SteadyClock::time_point> final_at;
+  std::int64_t sent_ns{0};       // system clock at send()
+  std::int64_t published_ns{0};  // the final status's stamp (the service's clock: same host)
+  std::int64_t arrived_ns{0};    // system clock when it arrived
+  bool sent_by_us{false};
+  bool found{false};
+  bool waiting_approval{false};
+};
+
+struct VehicleState {
+  std::string id;
+  std::mutex mutex;
+  std::map<std::uint64_t, Answer> answers;  // by request id
+  int mismatched_vehicle{0};
+};
+
+struct WorkerArgs {
+  int domain{0};
+  int first{0};  // global index of the first vehicle
+  int count{0};
+  int total{0};
+  double rate{1.0};
+  double duration{10.0};
+  bool participant_per_vehicle{false};
+  std::string dir;
+};
+
+int run_worker(const WorkerArgs& a) {
+  const pullout::PullOutRequest base =
+      pullout::load_scenario(source_path("tests/scenarios/straight_shoulder.yaml")).request;
+  std::optional<pullout::ClientParticipant> participant;
+  if (!a.participant_per_vehicle) {
+    pullout::ClientParticipantOptions po;
+    po.domain_id = a.domain;
+    participant.emplace(po);
+  }
+  const auto t0 = SteadyClock::now();
+  const auto note = [&](const char* what) {
+    std::printf("%.2f s: %s\n", std::chrono::duration<double>(SteadyClock::now() - t0).count(), what);
+    std::fflush(stdout);
+  };
+  std::vector<std::unique_ptr<VehicleState>> states;
+  std::vector<std::unique_ptr<pullout::Client>> clients;
+  for (int i = 0; i < a.count && !g_stop.load(); ++i) {
+    auto state = std::make_unique<VehicleState>();
+    state->id = "load-" + std::to_string(a.first + i);
+    pullout::ClientOptions options;
+    options.vehicle_id = state->id;
+    options.domain_id = a.domain;
+    auto client = participant ? std::make_unique<pullout::Client>(*participant, options)
+                              : std::make_unique<pullout::Client>(options);
+    VehicleState* s = state.get();
+    client->on_path([s](const pullout::PullOutPath& p) {
+      const auto now = SteadyClock::now();
+      std::lock_guard<std::mutex> lock(s->mutex);
+      if (p.vehicle_id != s->id) {
+        ++s->mismatched_vehicle;
+        return;
+      }
+      Answer& answer = s->answers[p.request_id];
+      if (!answer.path_at) {
+        answer.path_at = now;
+        answer.found = p.found;
+      }
+    });
+    client->on_status([s](const pullout::PullOutStatus& st) {
+      const auto now = SteadyClock::now();
+      std::lock_guard<std::mutex> lock(s->mutex);
+      if (st.vehicle_id != s->id) {
+        ++s->mismatched_vehicle;
+        return;
+      }
+      if (st.state == pullout::ExecutionState::kPlanning) return;
+      Answer& answer = s->answers[st.request_id];
+      if (!answer.final_at) {
+        answer.final_at = now;
+        answer.published_ns = st.stamp_ns;
+        answer.arrived_ns = system_ns();
+        answer.waiting_approval = st.state == pullout::ExecutionState::kWaitingApproval;
+      }
+    });
+    states.push_back(std::move(state));
+    clients.push_back(std::move(client));
+  }
+  note("clients created");
+  const auto setup_deadline = SteadyClock::now() + kSetupTimeout;
+  for (auto& client : clients) {
+    if (g_stop.load()) return 3;
+    const auto left = setup_deadline - SteadyClock::now();
+    if (left <= 0s || !client->wait_for_service(left)) {
+      std::fprintf(stderr, "worker %d: %s did not match the service\n", a.first, client->vehicle_id().c_str());
+      return 3;
+    }
+  }
+  note("clients matched");
+  std::ofstream(a.dir + "/ready." + std::to_string(a.first)) << "ready\n";
+
+  // The coordinator writes the start time (system clock ns) into the go file.
+  std::int64_t start_ns = 0;
+  while (!g_stop.load() && SteadyClock::now() < setup_deadline + kSetupTimeout) {
+    std::ifstream go(a.dir + "/go");
+    if (go >> start_ns) break;
+    std::this_thread::sleep_for(10ms);
+  }
+  if (start_ns == 0) return 3;
+
+  // Schedule: vehicle g sends at start + g / (total * rate) + k / rate.
+  const auto period_ns = static_cast<std::int64_t>(1e9 / a.rate);
+  const auto rounds = static_cast<int>(std::llround(a.duration * a.rate));
+  double max_lag_ms = 0.0;
+  std::uint64_t serial = 0;
+  for (int k = 0; k < rounds && !g_stop.load(); ++k) {
+    for (int i = 0; i < a.count && !g_stop.load(); ++i) {
+      const std::int64_t due =
+          start_ns + static_cast<std::int64_t>(k) * period_ns +
+          static_cast<std::int64_t>(static_cast<double>(a.first + i) / a.total * static_cast<double>(period_ns));
+      if (!sleep_until_ns(due)) break;
+      max_lag_ms = std::max(max_lag_ms, static_cast<double>(system_ns() - due) / 1e6);
+      // A pose that differs per vehicle and per request (golden-ratio steps: no two alike).
+      ++serial;
+      const double u = std::fmod(0.618033988749895 * static_cast<double>(serial + a.first), 1.0);
+      const double v = std::fmod(0.754877666246693 * static_cast<double>(serial + 7 * a.first), 1.0);
+      pullout::PullOutRequest request = base;
+      request.ego_pose.x = 6.0 + 24.0 * u;
+      request.ego_pose.y = 3.0 + 0.4 * v;
+      const auto sent = SteadyClock::now();
+      const std::int64_t sent_ns = system_ns();
+      const std::uint64_t id = clients[i]->send(request);
+      std::lock_guard<std::mutex> lock(states[i]->mutex);
+      Answer& answer = states[i]->answers[id];
+      answer.sent = sent;
+      answer.sent_ns = sent_ns;
+      answer.sent_by_us = true;
+    }
+  }
+  note("sending done");
+  // Drain: until everything is answered or kDrain.
+  const auto drain_end = SteadyClock::now() + kDrain;
+  while (!g_stop.load() && SteadyClock::now() < drain_end) {
+    bool all = true;
+    for (auto& s : states) {
+      std::lock_guard<std::mutex> lock(s->mutex);
+      for (const auto& [id, answer] : s->answers) all = all && answer.path_at && answer.final_at;
+    }
+    if (all) break;
+    std::this_thread::sleep_for(50ms);
+  }
+
+  // One line per request: latency [ms] (-1: lost), planned (0/1); then mismatched.
+  std::ofstream out(a.dir + "/result." + std::to_string(a.first) + ".tmp");
+  int mismatched = 0;
+  for (auto& s : states) {
+    std::lock_guard<std::mutex> lock(s->mutex);
+    mismatched += s->mismatched_vehicle;
+    for (const auto& [id, answer] : s->answers) {
+      if (!answer.sent_by_us) {
+        ++mismatched;  // a reply to a request this vehicle never sent
+        continue;
+      }
+      double latency = -1.0;
+      if (answer.path_at && answer.final_at) {
+        latency = std::chrono::duration<double, std::milli>(std::max(*answer.path_at, *answer.final_at) - answer.sent)
+                      .count();
+      }
+      out << latency << ' ' << (answer.found && answer.waiting_approval ? 1 : 0) << ' '
+          << (answer.final_at ? static_cast<double>(answer.published_ns - answer.sent_ns) / 1e6 : -1.0) << ' '
+          << (answer.final_at ? static_cast<double>(answer.arrived_ns - answer.published_ns) / 1e6 : -1.0) << '\n';
+    }
+  }
+  out << "mismatched " << mismatched << "\nmax_lag_ms " << max_lag_ms << '\n';
+  out.close();
+  std::filesystem::rename(a.dir + "/result." + std::to_string(a.first) + ".tmp",
+                          a.dir + "/result." + std::to_string(a.first));
+  note("results written");
+  clients.clear();
+  note("clients deleted");
+  return 0;
+}
+
+// ------------------------------------------------------------------------------------------------
+// Coordinator
+
+std::uint64_t lo_tx_bytes() {
+  std::ifstream in("/sys/class/net/lo/statistics/tx_bytes");
+  std::uint64_t bytes = 0;
+  if (!(in >> bytes)) throw std::runtime_error("cannot read /sys/class/net/lo/statistics/tx_bytes");
+  return bytes;
+}
+
+// utime + stime of a process [clock ticks] (0 if gone).
+std::uint64_t cpu_ticks(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = text.rfind(')');  // the command name may contain spaces
+  if (close == std::string::npos) return 0;
+  std::istringstream fields(text.substr(close + 2));
+  std::string field;
+  std::uint64_t utime = 0;
+  std::uint64_t stime = 0;
+  for (int i = 3; i <= 15 && fields >> field; ++i) {
+    if (i == 14) utime = std::stoull(field);
+    if (i == 15) stime = std::stoull(field);
+  }
+  return utime + stime;
+}
+
+// Machine CPU: (busy, total) jiffies from /proc/stat.
+std::pair<std::uint64_t, std::uint64_t> machine_jiffies() {
+  std::ifstream in("/proc/stat");
+  std::string cpu;
+  in >> cpu;
+  std::uint64_t v = 0;
+  std::uint64_t total = 0;
+  std::uint64_t idle = 0;
+  for (int i = 0; i < 8 && in >> v; ++i) {
+    total += v;
+    if (i == 3 || i == 4) idle += v;  // idle, iowait
+  }
+  return {total - idle, total};
+}
+
+double vm_kb(pid_t pid, const std::string& key) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string k;
+  while (in >> k) {
+    if (k == key + ":") {
+      double kb = 0;
+      in >> kb;
+      return kb;
+    }
+    in.ignore(4096, '\n');
+  }
+  return -1.0;
+}
+
+// UDP datagrams dropped for a full receive buffer (RcvbufErrors in /proc/net/snmp: this network
+// namespace's counters).
+std::uint64_t udp_rcvbuf_errors() {
+  std::ifstream in("/proc/net/snmp");
+  std::string line;
+  std::vector<std::string> names;
+  while (std::getline(in, line)) {
+    if (line.rfind("Udp:", 0) != 0) continue;
+    std::istringstream fields(line.substr(4));
+    std::vector<std::string> values{std::istream_iterator<std::string>(fields), std::istream_iterator<std::string>()};
+    if (names.empty()) {
+      names = values;
+      continue;
+    }
+    for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) {
+      if (names[i] == "RcvbufErrors") return std::stoull(values[i]);
+    }
+  }
+  return 0;
+}
+
+std::string load_text() {
+  double load[3] = {0, 0, 0};
+  if (::getloadavg(load, 3) != 3) return "?";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.2f %.2f %.2f", load[0], load[1], load[2]);
+  return buf;
+}
+
+struct Options {
+  int vehicles{1000};
+  int processes{4};
+  double rate{1.0};
+  double duration{30.0};
+  bool participant_per_vehicle{false};
+  bool no_netns{false};
+  bool inside{false};
+  std::string service_exe{PULLOUT_SERVICE_EXE};
+  std::string config_path{source_path("config/pullout.yaml")};
+};
+
+int run_coordinator(const Options& o) {
+  const bool count_bytes = o.inside;
+  const std::set<std::string> shm_before = integration::list_dev_shm();
+  integration::ServiceOptions service_options;
+  service_options.executable = o.service_exe;
+  service_options.config_path = o.config_path;
+  integration::ServiceProcess service(service_options);
+  const pid_t service_pid = service.pid();
+  integration::TempDir dir;
+  std::printf("bench_load: %d vehicles in %d processes (%s), %.2f Hz each, %.0f s; domain %d; load %s\n", o.vehicles,
+              o.processes, o.participant_per_vehicle ? "one participant per vehicle" : "shared participant", o.rate,
+              o.duration, service.domain(), load_text().c_str());
+  std::fflush(stdout);
+
+  std::vector<std::unique_ptr<integration::ChildProcess>> workers;
+  std::vector<int> firsts;
+  // On every exit: SIGTERM to all workers at once, then each is reaped (SIGKILL after a timeout).
+  struct StopWorkers {
+    std::vector<std::unique_ptr<integration::ChildProcess>>& workers;
+    ~StopWorkers() {
+      for (auto& w : workers) {
+        if (w->running()) ::kill(w->pid(), SIGTERM);
+      }
+      for (auto& w : workers) w->stop(kWorkerStopTimeout);
+    }
+  } stop_workers{workers};
+  const auto setup_start = SteadyClock::now();
+  for (int p = 0; p < o.processes; ++p) {
+    const int first = o.vehicles * p / o.processes;
+    const int count = o.vehicles * (p + 1) / o.processes - first;
+    std::vector<std::string> argv{self_exe(),   "--worker",
+                                  "--domain",   std::to_string(service.domain()),
+                                  "--first",    std::to_string(first),
+                                  "--count",    std::to_string(count),
+                                  "--vehicles", std::to_string(o.vehicles),
+                                  "--rate",     std::to_string(o.rate),
+                                  "--duration", std::to_string(o.duration),
+                                  "--dir",      dir.path()};
+    if (o.participant_per_vehicle) argv.push_back("--participant-per-vehicle");
+    workers.push_back(
+        std::make_unique<integration::ChildProcess>(argv, dir.path() + "/worker." + std::to_string(first) + ".out",
+                                                    dir.path() + "/worker." + std::to_string(first) + ".err"));
+    firsts.push_back(first);
+  }
+  // Every worker ready (its clients matched), bounded.
+  const auto ready = [&] {
+    for (int first : firsts) {
+      if (!std::filesystem::exists(dir.path() + "/ready." + std::to_string(first))) return false;
+    }
+    return true;
+  };
+  while (!ready()) {
+    for (std::size_t i = 0; i < workers.size(); ++i) {
+      if (!workers[i]->running()) {
+        throw std::runtime_error(
+            "worker " + std::to_string(firsts[i]) + " exited during setup: " +
+            integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts[i]) + ".err", 2000));
+      }
+    }
+    if (g_stop.load() || SteadyClock::now() - setup_start > kSetupTimeout) {
+      std::string progress;
+      for (int first : firsts) {
+        progress += "\nworker " + std::to_string(first) + ":\n" +
+                    integration::read_file_tail(dir.path() + "/worker." + std::to_string(first) + ".out", 500);
+      }
+      throw std::runtime_error("the workers' clients did not all match the service in time" + progress);
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  const double setup_s = std::chrono::duration<double>(SteadyClock::now() - setup_start).count();
+
+  // Idle loopback traffic, then go.
+  std::uint64_t idle_bytes = 0;
+  if (count_bytes) {
+    std::this_thread::sleep_for(1s);
+    const std::uint64_t b0 = lo_tx_bytes();
+    std::this_thread::sleep_for(kIdleWindow);
+    idle_bytes = lo_tx_bytes() - b0;
+  }
+  const std::int64_t start_ns = system_ns() + std::chrono::nanoseconds(kStartMargin).count();
+  {
+    std::ofstream go(dir.path() + "/go.tmp");
+    go << start_ns << '\n';
+  }
+  std::filesystem::rename(dir.path() + "/go.tmp", dir.path() + "/go");
+  if (!sleep_until_ns(start_ns)) throw std::runtime_error("stopped by a signal");
+  const std::uint64_t bytes0 = count_bytes ? lo_tx_bytes() : 0;
+  const std::uint64_t service0 = cpu_ticks(service_pid);
+  std::uint64_t workers0 = 0;
+  for (auto& w : workers) workers0 += cpu_ticks(w->pid());
+  const auto machine0 = machine_jiffies();
+  const std::uint64_t drops0 = udp_rcvbuf_errors();
+  const std::int64_t end_ns = start_ns + static_cast<std::int64_t>(o.duration * 1e9);
+  if (!sleep_until_ns(end_ns)) throw std::runtime_error("stopped by a signal");
+  const std::uint64_t bytes1 = count_bytes ? lo_tx_bytes() : 0;
+  const std::uint64_t service1 = cpu_ticks(service_pid);
+  std::uint64_t workers1 = 0;
+  for (auto& w : workers) workers1 += cpu_ticks(w->pid());
+  const auto machine1 = machine_jiffies();
+  const std::uint64_t drops = udp_rcvbuf_errors() - drops0;
+  const std::string load_after = load_text();
+
+  // Results: each worker writes its file after its drain (then deletes its clients).
+  const auto results_deadline = SteadyClock::now() + kDrain + 30s;
+  for (std::size_t i = 0; i < workers.size(); ++i) {
+    const std::string file = dir.path() + "/result." + std::to_string(firsts[i]);
+    while (!std::filesystem::exists(file)) {
+      if (g_stop.load() || SteadyClock::now() > results_deadline || !workers[i]->running()) {
+        throw std::runtime_error(
+            "worker " + std::to_string(firsts[i]) + " wrote no result: " +
+            integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts[i]) + ".out", 2000) +
+            integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts[i]) + ".err", 2000));
+      }
+      std::this_thread::sleep_for(50ms);
+    }
+  }
+  std::printf(
+      "worker %d: %s", firsts.front(),
+      integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts.front()) + ".out", 2000).c_str());
+  const double hwm_mb = vm_kb(service_pid, "VmHWM") / 1024.0;
+  std::vector<double> latencies;
+  std::vector<double> to_service_ms;    // send() -> the final status published
+  std::vector<double> from_service_ms;  // published -> arrived
+  std::size_t sent = 0;
+  std::size_t lost = 0;
+  std::size_t not_planned = 0;
+  int mismatched = 0;
+  double max_lag_ms = 0.0;
+  for (int first : firsts) {
+    std::ifstream in(dir.path() + "/result." + std::to_string(first));
+    std::string line;
+    while (std::getline(in, line)) {
+      std::istringstream fields(line);
+      std::string head;
+      fields >> head;
+      if (head == "mismatched") {
+        int m = 0;
+        fields >> m;
+        mismatched += m;
+      } else if (head == "max_lag_ms") {
+        double lag = 0;
+        fields >> lag;
+        max_lag_ms = std::max(max_lag_ms, lag);
+      } else if (!head.empty()) {
+        const double latency = std::stod(head);
+        int planned = 0;
+        double to_service = -1.0;
+        double from_service = -1.0;
+        fields >> planned >> to_service >> from_service;
+        if (to_service >= 0.0 || from_service >= 0.0) {
+          to_service_ms.push_back(to_service);
+          from_service_ms.push_back(from_service);
+        }
+        ++sent;
+        if (latency < 0) {
+          ++lost;
+        } else {
+          latencies.push_back(latency);
+          if (planned == 0) ++not_planned;
+        }
+      }
+    }
+  }
+  const pullout::bench::Summary s = pullout::bench::summarize(latencies);
+  const double ticks = static_cast<double>(::sysconf(_SC_CLK_TCK));
+  const double service_cpu = 100.0 * static_cast<double>(service1 - service0) / ticks / o.duration;
+  const double workers_cpu = 100.0 * static_cast<double>(workers1 - workers0) / ticks / o.duration;
+  const double machine_busy = 100.0 * static_cast<double>(machine1.first - machine0.first) /
+                              static_cast<double>(std::max<std::uint64_t>(1, machine1.second - machine0.second));
+  std::string bytes_text = "n/a";
+  if (count_bytes && sent > 0) {
+    const double window_s = static_cast<double>(end_ns - start_ns) / 1e9;
+    const double idle_rate = static_cast<double>(idle_bytes) / std::chrono::duration<double>(kIdleWindow).count();
+    const double per_request =
+        (static_cast<double>(bytes1 - bytes0) - idle_rate * window_s) / static_cast<double>(sent);
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.0f", per_request);
+    bytes_text = buf;
+  }
+  std::printf(
+      "setup (all clients matched) %.1f s; load after: %s; max send lag %.1f ms; UDP receive-buffer drops %llu%s\n",
+      setup_s, load_after.c_str(), max_lag_ms, static_cast<unsigned long long>(drops),
+      count_bytes ? "" : " (host-wide)");
+  const pullout::bench::Summary to = pullout::bench::summarize(to_service_ms);
+  const pullout::bench::Summary from = pullout::bench::summarize(from_service_ms);
+  std::printf("send -> final status published: p50 %.2f p99 %.2f ms; published -> arrived: p50 %.2f p99 %.2f ms\n\n",
+              to.p50, to.p99, from.p50, from.p99);
+  std::printf(
+      "| vehicles | processes | participants | rate [Hz] | sent | replies/s | p50 [ms] | p99 [ms] | max [ms] | lost | "
+      "mismatched | not planned | service CPU [%% core] | service peak RSS [MB] | workers CPU [%% core] | machine busy "
+      "[%%] | bytes/request |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| %d | %d | %s | %.2f | %zu | %.1f | %.2f | %.2f | %.2f | %zu | %d | %zu | %.0f | %.1f | %.0f | %.0f | %s |\n",
+      o.vehicles, o.processes, o.participant_per_vehicle ? "1 per vehicle" : "1 per process", o.rate, sent,
+      static_cast<double>(latencies.size()) / o.duration, s.p50, s.p99, s.max, lost, mismatched, not_planned,
+      service_cpu, hwm_mb, workers_cpu, machine_busy, bytes_text.c_str());
+
+  for (auto& w : workers) {
+    if (w->running()) ::kill(w->pid(), SIGTERM);
+  }
+  for (auto& w : workers) w->stop(kWorkerStopTimeout);
+  const integration::StopReport report = service.stop();
+  if (!report.clean()) std::printf("service stop: %s\n", report.describe().c_str());
+  // Anything this run left in /dev/shm and no live process holds.
+  const std::set<std::string> in_use = integration::dev_shm_files_in_use();
+  for (const auto& name : integration::list_dev_shm()) {
+    if (shm_before.count(name) == 0 && in_use.count(name) == 0) {
+      std::error_code ec;
+      std::filesystem::remove("/dev/shm/" + name, ec);
+    }
+  }
+  return lost == 0 && mismatched == 0 && sent > 0 ? 0 : 1;
+}
+
+// Outside: runs the coordinator in a network namespace of its own, forwarding SIGINT/SIGTERM to
+// it, and deletes the namespace afterwards.
+int run_in_netns(int argc, char** argv) {
+  const std::string ns = "pullout-load-" + std::to_string(::getpid());
+  if (std::system(("ip netns add " + ns).c_str()) != 0) throw std::runtime_error("ip netns add " + ns + " failed");
+  int rc = 1;
+  if (std::system(("ip -n " + ns + " link set lo up").c_str()) == 0) {
+    std::vector<std::string> args{"ip", "netns", "exec", ns, self_exe(), "--inside"};
+    for (int i = 1; i < argc; ++i) args.emplace_back(argv[i]);
+    const pid_t child = ::fork();
+    if (child == 0) {
+      std::vector<char*> c_args;
+      for (auto& a : args) c_args.push_back(a.data());
+      c_args.push_back(nullptr);
+      ::execvp("ip", c_args.data());
+      ::_exit(127);
+    }
+    int status = 0;
+    while (::waitpid(child, &status, 0) < 0) {
+      if (errno != EINTR) break;
+      if (g_stop.load()) ::kill(child, SIGTERM);
+    }
+    rc = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  } else {
+    std::fprintf(stderr, "bench_load: cannot bring lo up in %s\n", ns.c_str());
+  }
+  std::system(("ip netns delete " + ns).c_str());
+  return rc;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  struct sigaction action {};
+  action.sa_handler = on_signal;  // no SA_RESTART: waitpid returns EINTR
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+
+  CLI::App app{"Load: many vehicles over several processes against one pullout_service"};
+  Options o;
+  WorkerArgs w;
+  bool worker = false;
+  app.add_option("--vehicles", o.vehicles, "vehicles in all")->check(CLI::Range(1, 4000));
+  app.add_option("--processes", o.processes, "worker processes")->check(CLI::Range(1, 16));
+  app.add_option("--rate", o.rate, "requests per second per vehicle")->check(CLI::Range(0.01, 100.0));
+  app.add_option("--duration", o.duration, "seconds of sending")->check(CLI::Range(1.0, 150.0));
+  app.add_flag("--participant-per-vehicle", o.participant_per_vehicle, "one DDS participant per vehicle");
+  app.add_flag("--no-netns", o.no_netns, "do not use a network namespace (no byte count)");
+  app.add_option("--service", o.service_exe, "the pullout_service binary");
+  app.add_option("--config", o.config_path, "the service's config");
+  app.add_flag("--inside", o.inside, "(internal) inside the namespace");
+  app.add_flag("--worker", worker, "(internal) a worker process");
+  app.add_option("--domain", w.domain, "(internal)");
+  app.add_option("--first", w.first, "(internal)");
+  app.add_option("--count", w.count, "(internal)");
+  app.add_option("--dir", w.dir, "(internal)");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (worker) {
+      w.total = o.vehicles;
+      w.rate = o.rate;
+      w.duration = o.duration;
+      w.participant_per_vehicle = o.participant_per_vehicle;
+      return run_worker(w);
+    }
+    if (o.processes > o.vehicles) throw std::runtime_error("--processes exceeds --vehicles");
+    if (!o.inside && !o.no_netns && ::geteuid() == 0) return run_in_netns(argc, argv);
+    return run_coordinator(o);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_load%s: %s\n", worker ? " worker" : "", e.what());
+    return 1;
+  }
+}
