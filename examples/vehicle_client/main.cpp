@@ -43,8 +43,9 @@ std::int64_t now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
 }
 
-// The situation: a straight two-lane road, the vehicle parked on the shoulder (left), the goal
-// ahead on the road lane. A vehicle builds this from its map and perception.
+// The situation: a straight road with a shoulder on its left, the vehicle parked on the shoulder
+// 3 m behind a parked car (too close to pull out directly), the goal ahead on the road lane. The service plans two
+// segments: reverse along the shoulder, then shift out. A vehicle builds this from its map and perception.
 pullout::PullOutRequest make_request() {
   pullout::PullOutRequest request;
   pullout::Lane road;
@@ -55,9 +56,16 @@ pullout::PullOutRequest make_request() {
   pullout::Lane shoulder;
   shoulder.id = 2;
   shoulder.subtype = pullout::LaneSubtype::kRoadShoulder;
-  shoulder.left_bound = {{0.0, 4.75}, {100.0, 4.75}};
-  shoulder.right_bound = {{0.0, 1.75}, {100.0, 1.75}};
+  shoulder.left_bound = {{-30.0, 4.75}, {100.0, 4.75}};
+  shoulder.right_bound = {{-30.0, 1.75}, {100.0, 1.75}};
   request.lanes = {road, shoulder};
+  pullout::Object parked_car;
+  parked_car.id = 7;
+  parked_car.object_class = pullout::ObjectClass::kCar;
+  parked_car.pose = {19.04, 3.25, 0.0};
+  parked_car.length_m = 4.5;
+  parked_car.width_m = 1.9;
+  request.objects = {parked_car};
   request.ego_pose = {10.0, 3.25, 0.0};
   request.goal_pose = {90.0, 0.0, 0.0};
   return request;

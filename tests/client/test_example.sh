@@ -5,7 +5,8 @@
 # pullout_service on loopback (a DDS domain leased like the C++ tests do, by flock on
 # /tmp/pullout-dds-domain-N.lock). Checks that
 #   - without its approval the example does not depart (exit 4, never "executing"),
-#   - with it, the vehicle is released ("executing") and follows every segment to "completed".
+#   - with it, the vehicle is released ("executing") and follows both segments (reverse, then
+#     shift out past a parked car) to "completed".
 # usage: test_example.sh <cmake> <pullout build dir> <example source dir> <pullout_service> <config>
 set -euo pipefail
 
@@ -73,6 +74,7 @@ timeout 90 "$example" --domain "$domain" --vehicle example-approved --approve >"
 cat "$work/approved.out"
 [ "$status" -eq 0 ] || fail "the example exited with $status"
 grep -q "^executing$" "$work/approved.out" || fail "never executing"
+grep -q "^segment 2/2" "$work/approved.out" || fail "the two segments (reverse, shift) were not followed"
 grep -q "^completed$" "$work/approved.out" || fail "never completed"
 
 kill -TERM "$service_pid"

@@ -1,8 +1,8 @@
 // The service's Prometheus metrics without DDS: what a status counts as, and the field classes of
 // rejections (bounded label values).
 #include <gtest/gtest.h>
-#include <prometheus/text_serializer.h>
 #include <prometheus/registry.h>
+#include <prometheus/text_serializer.h>
 
 #include <sstream>
 #include <string>
