@@ -114,6 +114,7 @@ std::string read_status_line(int fd, Clock::time_point deadline) {
 }  // namespace
 
 bool parse_http_url(const std::string& url, HttpUrl& parsed, std::string& error) {
+  parsed = HttpUrl{};  // the defaults (port 80, path /), whatever it held
   constexpr const char* kScheme = "http://";
   if (url.compare(0, std::strlen(kScheme), kScheme) != 0) {
     error = "only http:// URLs are supported";

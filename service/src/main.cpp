@@ -52,11 +52,11 @@ sigset_t block_stop_signals() {
   return set;
 }
 
-// Waits for SIGINT or SIGTERM, or for `give_up` to return true (polled every 200 ms); returns the
+// Waits for SIGINT or SIGTERM, or for `give_up` to return true (polled every second); returns the
 // signal's name, or null when give_up ended the wait.
 template <typename GiveUp>
 const char* wait_for_stop_signal(const sigset_t& set, GiveUp give_up) {
-  const timespec poll_period{0, 200'000'000};
+  const timespec poll_period{1, 0};
   while (true) {
     const int sig = sigtimedwait(&set, nullptr, &poll_period);
     if (sig == SIGINT) return "SIGINT";
