@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
 
 #include "config/config_detail.hpp"
@@ -57,10 +58,20 @@ void service_problems(const ServiceConfig& s, Problems& problems) {
   }
 }
 
+// The metrics address must be an IPv4 address in dotted form (the HTTP server binds it as given).
+void observability_problems(const ObservabilityConfig& o, Problems& problems) {
+  in_addr parsed{};
+  if (!o.metrics.address.empty() && inet_pton(AF_INET, o.metrics.address.c_str(), &parsed) != 1) {
+    problems.push_back("observability.metrics.address: must be an IPv4 address such as 127.0.0.1, got '" +
+                       o.metrics.address + "'");
+  }
+}
+
 // Checks between keys of the whole config: the core's (start_planner) and the service's.
 void cross_key_problems(const Config& config, Problems& problems) {
   append_parameter_issues(validate_parameters(config.start_planner), "start_planner", problems);
   service_problems(config.service, problems);
+  observability_problems(config.observability, problems);
 }
 
 // Resolves dds.profiles_file relative to the config file (the table has checked it is not empty).

@@ -2,9 +2,12 @@
 
 #include <exception>
 
+#include <unistd.h>
+
 #include <cstring>
 #include <deque>
 #include <set>
+#include <sstream>
 #include <utility>
 
 #include <fastdds/rtps/builtin/data/ParticipantProxyData.h>
@@ -120,15 +123,58 @@ void check_endpoint_qos(const char* profile, const Qos& qos, dds::DurabilityQosP
 // It also notes the partition of every remote path or status reader (a vehicle's: access control
 // has checked that its permissions grant that partition), so that the dispatcher creates that
 // vehicle's writers before its first reply (its client waits for them to match).
+//
+// In every mode it also watches for other pullout_service participants on the domain (their user
+// data is kServiceUserData): two services both plan and publish for every vehicle, and the last
+// writer wins. Each one that appears is logged as a warning, and counted (other_services).
 class DdsEdge::Discovery final : public dds::DomainParticipantListener {
  public:
-  // track_partitions: secure mode (the partitions of readers and writers matter only there).
-  Discovery(dds::GuardCondition& wake, bool track_partitions) : wake_(wake), track_partitions_(track_partitions) {}
+  // secure: the partitions of readers and writers matter only in secure mode.
+  Discovery(dds::GuardCondition& wake, bool secure, int domain_id)
+      : wake_(wake), secure_(secure), domain_id_(domain_id) {}
+
+  void on_participant_discovery(dds::DomainParticipant* /*participant*/,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+    const auto& guid_prefix = info.info.m_guid.guidPrefix;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (info.status == Status::DISCOVERED_PARTICIPANT &&
+        info.info.m_VendorId != eprosima::fastrtps::rtps::c_VendorId_eProsima) {
+      remember_foreign(guid_prefix);
+      return;
+    }
+    if (info.status == Status::REMOVED_PARTICIPANT || info.status == Status::DROPPED_PARTICIPANT) {
+      const auto it = services_.find(guid_prefix);
+      if (it == services_.end()) return;
+      spdlog::info("the other pullout_service '{}' left DDS domain {} ({} other service(s) remain)", it->second,
+                   domain_id_, services_.size() - 1);
+      services_.erase(it);
+      return;
+    }
+    const auto& data = info.info.m_userData.data_vec();
+    const std::string user_data(data.begin(), data.end());
+    if (user_data != kServiceUserData || services_.count(guid_prefix) != 0) return;
+    const std::string name = info.info.m_participantName.to_string();
+    services_.emplace(guid_prefix, name);
+    std::ostringstream guid;
+    guid << guid_prefix;
+    spdlog::warn(
+        "another pullout_service is on DDS domain {}: participant '{}' (GUID prefix {}). Both plan and publish for "
+        "every vehicle and the last writer wins; stop one of them or give each its own domain "
+        "(observability.on_duplicate_service)",
+        domain_id_, name, guid.str());
+  }
+
+  // How many other pullout_service participants are on the domain now.
+  std::size_t other_services() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return services_.size();
+  }
 
   void on_subscriber_discovery(dds::DomainParticipant* /*participant*/,
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::ReaderDiscoveryInfo;
-    if (!track_partitions_ || info.status == Status::REMOVED_READER) return;
+    if (!secure_ || info.status == Status::REMOVED_READER) return;
     const std::string topic = info.info.topicName().to_string();
     if (topic != kPathTopic && topic != kStatusTopic) return;
     const auto& names = info.info.m_qos.m_partition.names();
@@ -150,7 +196,7 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   void on_publisher_discovery(dds::DomainParticipant* /*participant*/,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo;
-    if (!track_partitions_) return;
+    if (!secure_) return;  // only secure mode asks writer_partition_is
     const auto& guid = info.info.guid();
     std::lock_guard<std::mutex> lock(mutex_);
     if (info.status == Status::REMOVED_WRITER) {
@@ -158,23 +204,6 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
       return;
     }
     partitions_[guid] = info.info.m_qos.m_partition.names();
-  }
-
-  void on_participant_discovery(dds::DomainParticipant* /*participant*/,
-                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
-    using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
-    if (info.status != Status::DISCOVERED_PARTICIPANT) return;
-    if (info.info.m_VendorId == eprosima::fastrtps::rtps::c_VendorId_eProsima) return;
-    const auto& prefix = info.info.m_guid.guidPrefix;
-    std::lock_guard<std::mutex> lock(mutex_);
-    // Kept after the participant leaves: a sample of its writers may still be waiting in a
-    // reader. Bounded: the oldest are forgotten first.
-    if (!foreign_.insert(prefix).second) return;
-    foreign_order_.push_back(prefix);
-    if (foreign_order_.size() > kMaxForeignParticipants) {
-      foreign_.erase(foreign_order_.front());
-      foreign_order_.pop_front();
-    }
   }
 
   // Whether the writer with this handle belongs to a participant of another DDS vendor.
@@ -193,14 +222,29 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   }
 
  private:
+  // Kept after the participant leaves: a sample of its writers may still be waiting in a reader.
+  // Bounded: the oldest are forgotten first. Called with mutex_ held.
+  void remember_foreign(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+    if (!foreign_.insert(prefix).second) return;
+    foreign_order_.push_back(prefix);
+    if (foreign_order_.size() > kMaxForeignParticipants) {
+      foreign_.erase(foreign_order_.front());
+      foreign_order_.pop_front();
+    }
+  }
+
   // Bounds the set between two dispatcher wake-ups (only authenticated participants add to it).
   static constexpr std::size_t kMaxPendingVehicles = 65536;
   static constexpr std::size_t kMaxForeignParticipants = 65536;
   dds::GuardCondition& wake_;
-  const bool track_partitions_;
+  const bool secure_;
+  const int domain_id_;
   mutable std::mutex mutex_;
   std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> partitions_;
   std::set<std::string> pending_readers_;
+  // Other services: GUID prefix -> participant name.
+  std::map<eprosima::fastrtps::rtps::GuidPrefix_t, std::string> services_;
+  // Participants of other DDS vendors, oldest first forgotten.
   std::set<eprosima::fastrtps::rtps::GuidPrefix_t> foreign_;
   std::deque<eprosima::fastrtps::rtps::GuidPrefix_t> foreign_order_;
 };
@@ -225,32 +269,38 @@ void DdsEdge::create_entities(const DdsConfig& config) {
     throw DdsSetupError("cannot load DDS profiles file " + config.profiles_file);
   }
   secure_ = !config.security_dir.empty();
-  // The discovery callbacks are not masked by the StatusMask: none keeps every other status
-  // (data available, matches) off the listener, on the dispatcher's wait set.
-  discovery_ = std::make_unique<Discovery>(discovery_wake_, secure_);
+  dds::DomainParticipantQos qos;
+  if (factory->get_participant_qos_from_profile(config.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
+    throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + config.profiles_file);
+  }
+  // Marks this participant as a pullout service for the other services' Discovery; a name that
+  // says where it runs, unless the profile gives one.
+  qos.user_data().data_vec(
+      std::vector<eprosima::fastrtps::rtps::octet>(kServiceUserData.begin(), kServiceUserData.end()));
+  if (qos.name().to_string().empty() || qos.name().to_string() == "RTPSParticipant") {
+    char host[256] = {};
+    if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+    qos.name(("pullout_service@" + std::string(host) + " pid " + std::to_string(getpid())).substr(0, 255));
+  }
   if (secure_) {
-    dds::DomainParticipantQos qos;
-    if (factory->get_participant_qos_from_profile(config.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
-      throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + config.profiles_file);
-    }
     try {
       idl::add_security_properties(config.security_dir, qos);
     } catch (const std::invalid_argument& e) {
       throw DdsSetupError(std::string("dds.security_dir: ") + e.what());
     }
-    participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
-    if (participant_ == nullptr) {
+  }
+  // The discovery callbacks are not masked by the StatusMask: none keeps every other status
+  // (data available, matches) off the listener, on the dispatcher's wait set.
+  discovery_ = std::make_unique<Discovery>(discovery_wake_, secure_, config.domain_id);
+  participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
+  if (participant_ == nullptr) {
+    if (secure_) {
       throw DdsSetupError("cannot create the secure DDS participant with the credentials in " + config.security_dir +
                           " (profile '" + config.participant_profile + "' of " + config.profiles_file + ", domain " +
                           std::to_string(config.domain_id) + "): see the SECURITY errors of Fast DDS above");
     }
-  } else {
-    participant_ = factory->create_participant_with_profile(config.domain_id, config.participant_profile,
-                                                            discovery_.get(), dds::StatusMask::none());
-    if (participant_ == nullptr) {
-      throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
-                          config.profiles_file + " on domain " + std::to_string(config.domain_id));
-    }
+    throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
+                        config.profiles_file + " on domain " + std::to_string(config.domain_id));
   }
 
   request_topic_ = create_topic(*participant_, kRequestTopic, idl::make_guarded_type<msg::PullOutRequestPubSubType>());
@@ -349,6 +399,8 @@ void DdsEdge::destroy() noexcept {
   std::lock_guard<std::mutex> lock(vehicle_writers_mutex_);
   vehicle_writers_.clear();  // deleted with the participant's entities
 }
+
+std::size_t DdsEdge::other_services() const { return discovery_ ? discovery_->other_services() : 0; }
 
 void DdsEdge::prepare_discovered_vehicles() {
   if (!secure_) return;
