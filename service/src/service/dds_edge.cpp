@@ -30,6 +30,7 @@
 #include "pullout/idl/guarded_type.hpp"
 #include "pullout/idl/security.hpp"
 #include "pullout/model/names.hpp"
+#include "service/builtin_profiles.hpp"
 
 namespace pullout::service {
 namespace dds = eprosima::fastdds::dds;
@@ -184,14 +185,20 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   auto* factory = dds::DomainParticipantFactory::get_instance();
   // Fast DDS only logs a missing or malformed XML file and then silently uses its defaults (all
   // interfaces, shared memory): that must stop the service instead.
-  if (factory->load_XML_profiles_file(config.profiles_file) != ReturnCode_t::RETCODE_OK) {
+  if (config.profiles_file.empty()) {
+    const std::string xml(kBuiltinProfilesXml);
+    if (factory->load_XML_profiles_string(xml.c_str(), xml.size()) != ReturnCode_t::RETCODE_OK) {
+      throw DdsSetupError("cannot load the built-in DDS profiles");
+    }
+  } else if (factory->load_XML_profiles_file(config.profiles_file) != ReturnCode_t::RETCODE_OK) {
     throw DdsSetupError("cannot load DDS profiles file " + config.profiles_file);
   }
+  const std::string profiles = describe_profiles(config);
   secure_ = !config.security_dir.empty();
   if (secure_) {
     dds::DomainParticipantQos qos;
     if (factory->get_participant_qos_from_profile(config.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
-      throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + config.profiles_file);
+      throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + profiles);
     }
     try {
       idl::add_security_properties(config.security_dir, qos);
@@ -202,14 +209,14 @@ void DdsEdge::create_entities(const DdsConfig& config) {
     participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
     if (participant_ == nullptr) {
       throw DdsSetupError("cannot create the secure DDS participant with the credentials in " + config.security_dir +
-                          " (profile '" + config.participant_profile + "' of " + config.profiles_file + ", domain " +
+                          " (profile '" + config.participant_profile + "' of " + profiles + ", domain " +
                           std::to_string(config.domain_id) + "): see the SECURITY errors of Fast DDS above");
     }
   } else {
     participant_ = factory->create_participant_with_profile(config.domain_id, config.participant_profile);
     if (participant_ == nullptr) {
       throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
-                          config.profiles_file + " on domain " + std::to_string(config.domain_id));
+                          profiles + " on domain " + std::to_string(config.domain_id));
     }
   }
 
@@ -227,7 +234,7 @@ void DdsEdge::create_entities(const DdsConfig& config) {
 
   const auto missing_profile = [&](const char* what, const char* profile) {
     return DdsSetupError(std::string("cannot create the ") + what + " from profile '" + profile + "' (is it in " +
-                         config.profiles_file + "?)");
+                         profiles + "?)");
   };
   // Readers and writers are created without listeners: samples are taken on the dispatcher thread.
   request_reader_ = subscriber_->create_datareader_with_profile(request_topic_, kRequestReaderProfile, nullptr,
