@@ -1,14 +1,14 @@
 # pullout_assert_core_links(TARGETS <targets...> [FORBIDDEN <regex>])
 #
 # Fails the configuration when one of TARGETS links, directly or through any chain of targets,
-# a library whose name matches FORBIDDEN (default: Fast DDS, Fast CDR, yaml-cpp, spdlog, and the
-# project's own DDS and YAML libraries). The planning core calls it on its modules: it must not
-# depend on DDS, YAML or logging. Checked on the link items as written (target names, library
+# a library whose name matches FORBIDDEN (default: Fast DDS, Fast CDR, yaml-cpp, spdlog, Prometheus
+# and its HTTP server, and the project's own DDS and YAML libraries). The planning core calls it on
+# its modules: it must not depend on DDS, YAML, logging or metrics. Checked on the link items as written (target names, library
 # paths), private links included.
 function(pullout_assert_core_links)
   cmake_parse_arguments(ARG "" "FORBIDDEN" "TARGETS" ${ARGN})
   if(NOT ARG_FORBIDDEN)
-    set(ARG_FORBIDDEN "fastrtps|fastcdr|fastdds|yaml-cpp|spdlog|pullout_idl|pullout_config")
+    set(ARG_FORBIDDEN "fastrtps|fastcdr|fastdds|yaml-cpp|spdlog|prometheus|civetweb|pullout_idl|pullout_config")
   endif()
   foreach(root IN LISTS ARG_TARGETS)
     set(queue ${root})

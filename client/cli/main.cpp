@@ -1,10 +1,13 @@
 // pullout: plan a pull-out in-process, or ask a running pullout service over DDS.
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "health_probe.hpp"
+#include "pullout/version.hpp"
 
 namespace {
 
@@ -16,7 +19,8 @@ constexpr const char* kExitCodes =
     "       field), request rejected by the planner, SVG file not writable\n"
     "  3    communication failure or timeout (request: no service, no answer in time)\n"
     "  4    internal error\n"
-    "  130  interrupted\n";
+    "  130  interrupted\n"
+    "health: 0 the URL answered 200, 1 another HTTP status, 2 bad URL, 3 no answer (refused, timeout)\n";
 
 }  // namespace
 
@@ -24,6 +28,7 @@ int main(int argc, char** argv) {
   CLI::App app{"pullout: start (pull-out) planner for automated vehicles"};
   app.require_subcommand(1);
   app.footer(kExitCodes);
+  app.set_version_flag("--version", std::string("pullout ") + pullout::kVersionString);
 
   pullout::cli::PlanOptions plan;
   CLI::App* plan_cmd = app.add_subcommand("plan", "Plan in-process with the service's pipeline");
@@ -60,6 +65,17 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
 
+  pullout::cli::HealthOptions health;
+  CLI::App* health_cmd = app.add_subcommand(
+      "health",
+      "GET an HTTP URL (e.g. the service's http://127.0.0.1:9464/readyz) and exit 0 if it answers 200: a "
+      "container HEALTHCHECK without curl");
+  health_cmd->add_option("url", health.url, "http://host:port/path")->required();
+  health_cmd->add_option("--timeout", health.timeout_s, "Seconds for connecting and the answer")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  health_cmd->add_flag("-q,--quiet", health.quiet, "Print nothing on success");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -69,6 +85,7 @@ int main(int argc, char** argv) {
 
   try {
     if (plan_cmd->parsed()) return pullout::cli::run_plan(plan, std::cout, std::cerr);
+    if (health_cmd->parsed()) return pullout::cli::run_health(health, std::cout, std::cerr);
     pullout::cli::install_interrupt_handlers();
     return pullout::cli::run_request(request, std::cout, std::cerr);
   } catch (const std::exception& e) {

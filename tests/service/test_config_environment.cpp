@@ -157,6 +157,23 @@ TEST(ConfigEnvironment, SecurityDirIsCheckedUnderTheVariablesName) {
   EXPECT_EQ(p[0], "PULLOUT_DDS_SECURITY_DIR: directory not found: /nowhere/pki");
 }
 
+TEST(ConfigEnvironment, MetricsEndpoint) {
+  ConfigDir file("");
+  const Config c =
+      load_config(file.config, fake({{"PULLOUT_METRICS_ENABLED", "true"}, {"PULLOUT_METRICS_ADDRESS", "0.0.0.0"}}));
+  EXPECT_TRUE(c.observability.metrics.enabled);
+  EXPECT_EQ(c.observability.metrics.address, "0.0.0.0");
+  EXPECT_FALSE(load_config(file.config, fake({{"PULLOUT_METRICS_ENABLED", "false"}})).observability.metrics.enabled);
+  EXPECT_FALSE(load_config(file.config, fake({})).observability.metrics.enabled);
+
+  auto p = problems_of(file.config, fake({{"PULLOUT_METRICS_ENABLED", "yes"}}));
+  ASSERT_EQ(p.size(), 1u) << dump(p);
+  EXPECT_EQ(p[0].rfind("PULLOUT_METRICS_ENABLED: must be true or false", 0), 0u) << p[0];
+  p = problems_of(file.config, fake({{"PULLOUT_METRICS_ADDRESS", "localhost"}}));
+  ASSERT_EQ(p.size(), 1u) << dump(p);
+  EXPECT_EQ(p[0].rfind("PULLOUT_METRICS_ADDRESS: must be an IPv4 address", 0), 0u) << p[0];
+}
+
 TEST(ConfigEnvironment, EveryBadVariableIsReportedWithTheFilesProblems) {
   ConfigDir file("service: {worker_threads: 0}\n");
   const auto p = problems_of(file.config, fake({{"PULLOUT_DOMAIN_ID", "x"}, {"PULLOUT_DDS_PROFILE", "nope"}}));

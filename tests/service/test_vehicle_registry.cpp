@@ -232,3 +232,61 @@ TEST_F(Registry, ASweepEvictsAtMostItsBound) {
 
 }  // namespace
 }  // namespace pullout::service
+
+namespace pullout::service {
+namespace {
+
+// The statistics observers (the service's metrics): one reply per request and outcome, whatever
+// the session re-publishes; one call per eviction with its reason.
+class RegistryObservers : public Registry {
+ protected:
+  void SetUp() override {
+    spdlog::set_level(spdlog::level::warn);
+    RegistryOptions o;
+    o.max_vehicles = 2;
+    o.session_idle_timeout_s = 60.0;
+    o.clock = [this] { return now_; };
+    o.on_reply = [this](const PullOutStatus& s) { replies_.push_back(s); };
+    o.on_evicted = [this](int reason) { evictions_.push_back(static_cast<EvictionReason>(reason)); };
+    registry_ = std::make_unique<VehicleRegistry>(planner_, outbox_, o);
+  }
+  std::vector<PullOutStatus> replies_;
+  std::vector<EvictionReason> evictions_;
+};
+
+TEST_F(RegistryObservers, OneReplyPerRequestEvenWhenTheSessionRepublishes) {
+  serve("a", 1);
+  ASSERT_EQ(replies_.size(), 1u);
+  EXPECT_TRUE(has_path(replies_[0].state));
+  // The client re-sends the answered request unchanged: the session answers again, no new reply.
+  const std::size_t statuses = outbox_.statuses.size();
+  EXPECT_FALSE(registry_->on_request(request("a", 1), {}).has_value());
+  EXPECT_GT(outbox_.statuses.size(), statuses) << "the session did not re-publish (the check would be void)";
+  // Progress changes the state (approved, executing) on the same request: still one reply.
+  progress("a", 1, 1'000'000'000, true);
+  progress("a", 1, 1'100'000'000, true);
+  EXPECT_EQ(replies_.size(), 1u);
+  // A new request is a new reply (searched, or answered with the same path under the new id).
+  if (std::optional<PlanningJob> job = registry_->on_request(request("a", 2), {})) {
+    registry_->on_result(*job, planner_.plan(job->request, StopCondition()));
+  }
+  ASSERT_EQ(replies_.size(), 2u);
+  EXPECT_EQ(replies_[1].request_id, 2u);
+}
+
+TEST_F(RegistryObservers, RejectionsAndEvictionsAreReported) {
+  PullOutRequest bad = request("b", 1);
+  bad.lanes.clear();
+  EXPECT_FALSE(registry_->on_request(bad, {}).has_value());
+  ASSERT_EQ(replies_.size(), 1u);
+  EXPECT_EQ(replies_[0].state, ExecutionState::kRejected);
+  serve("a", 1);
+  now_ += seconds(60);
+  registry_->on_time();
+  ASSERT_EQ(evictions_.size(), 2u);
+  EXPECT_EQ(evictions_[0], EvictionReason::kIdle);
+  EXPECT_EQ(evictions_[1], EvictionReason::kIdle);
+}
+
+}  // namespace
+}  // namespace pullout::service

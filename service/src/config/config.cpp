@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
 
 #include "config/config_detail.hpp"
@@ -58,10 +59,20 @@ void service_problems(const ServiceConfig& s, Problems& problems) {
   }
 }
 
+// The metrics address must be an IPv4 address in dotted form (the HTTP server binds it as given).
+void observability_problems(const ObservabilityConfig& o, Problems& problems) {
+  in_addr parsed{};
+  if (!o.metrics.address.empty() && inet_pton(AF_INET, o.metrics.address.c_str(), &parsed) != 1) {
+    problems.push_back("observability.metrics.address: must be an IPv4 address such as 127.0.0.1, got '" +
+                       o.metrics.address + "'");
+  }
+}
+
 // Checks between keys of the whole config: the core's (start_planner) and the service's.
 void cross_key_problems(const Config& config, Problems& problems) {
   append_parameter_issues(validate_parameters(config.start_planner), "start_planner", problems);
   service_problems(config.service, problems);
+  observability_problems(config.observability, problems);
 }
 
 // Resolves dds.profiles_file relative to the config file; empty stays empty (the built-in
@@ -121,8 +132,9 @@ std::string joined_profile_names() {
   return out;
 }
 
-// Applies kEnvironmentVariables onto `d`, appending one line per bad value.
-void apply_environment(DdsConfig& d, const Environment& env, Origins& origins, Problems& problems) {
+// Applies kEnvironmentVariables onto `config`, appending one line per bad value.
+void apply_environment(Config& config, const Environment& env, Origins& origins, Problems& problems) {
+  DdsConfig& d = config.dds;
   if (const auto v = variable(env, "PULLOUT_DOMAIN_ID")) {
     const bool digits =
         v->size() <= 3 && std::all_of(v->begin(), v->end(), [](unsigned char c) { return std::isdigit(c) != 0; });
@@ -156,6 +168,28 @@ void apply_environment(DdsConfig& d, const Environment& env, Origins& origins, P
   if (const auto v = variable(env, "PULLOUT_DDS_SECURITY_DIR")) {
     d.security_dir = *v;
     origins.security_dir = "PULLOUT_DDS_SECURITY_DIR";
+  }
+  MetricsConfig& m = config.observability.metrics;
+  if (const auto v = variable(env, "PULLOUT_METRICS_ENABLED")) {
+    if (*v == "true" || *v == "false") {
+      m.enabled = *v == "true";
+    } else {
+      problems.push_back(
+          "PULLOUT_METRICS_ENABLED: must be true or false (it overrides "
+          "observability.metrics.enabled), got '" +
+          *v + "'");
+    }
+  }
+  if (const auto v = variable(env, "PULLOUT_METRICS_ADDRESS")) {
+    in_addr parsed{};
+    if (inet_pton(AF_INET, v->c_str(), &parsed) == 1) {
+      m.address = *v;
+    } else {
+      problems.push_back(
+          "PULLOUT_METRICS_ADDRESS: must be an IPv4 address such as 0.0.0.0 (it overrides "
+          "observability.metrics.address), got '" +
+          *v + "'");
+    }
   }
 }
 
@@ -248,7 +282,7 @@ Config load_config(const std::string& path, const Environment& env) {
     // Reading checks each key's type and allowed values and reports unknown keys.
     config_table::read_table(config_table::config_file_table(), root, config);
     Origins origins;
-    apply_environment(config.dds, env, origins, problems);
+    apply_environment(config, env, origins, problems);
     cross_key_problems(config, problems);
     const std::filesystem::path dir = std::filesystem::path(path).parent_path();
     resolve_dds(config.dds, dir, origins.profiles_file, problems);

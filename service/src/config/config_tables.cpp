@@ -458,6 +458,33 @@ const Table<MapConfig>& map_table() {
   return t;
 }
 
+const Table<MetricsConfig>& metrics_table() {
+  using T = MetricsConfig;
+  static const Table<T> t{{
+      field("enabled", &T::enabled, "", AnyValue{}, "serve /metrics, /healthz and /readyz over HTTP"),
+      field("address", &T::address, "", NonEmpty{}, "IPv4 address to listen on; 0.0.0.0 = every interface"),
+      field("port", &T::port, "", in(1, 65535), "TCP port"),
+  }};
+  return t;
+}
+
+const Table<ObservabilityConfig>& observability_table() {
+  using T = ObservabilityConfig;
+  static const Table<T> t{{
+      note<T>("Prometheus metrics (pullout_* at /metrics) and health endpoints on one HTTP port: /healthz\n"
+              "answers 200 while the dispatcher loop is responsive, /readyz once the DDS entities, the config\n"
+              "and the planning threads are up. No authentication: keep the address on loopback or a\n"
+              "management network."),
+      group("metrics", &T::metrics, &metrics_table, ""),
+      field("log_format", &T::log_format, "", Choices{{kLogFormats.begin(), kLogFormats.end()}},
+            "json: one JSON object per line (time, level, logger, message, fields); --log-format overrides it"),
+      field("on_duplicate_service", &T::on_duplicate_service, "",
+            Choices{{kDuplicatePolicies.begin(), kDuplicatePolicies.end()}},
+            "another pullout_service on the domain: warn (log, metric) or exit (code 4)"),
+  }};
+  return t;
+}
+
 }  // namespace
 
 const Table<Config>& config_file_table() {
@@ -477,6 +504,8 @@ const Table<Config>& config_file_table() {
               "Loaded once at start-up; a file that cannot be read or parsed stops the service with one line.",
               true),
       group("map", &T::map, &map_table, ""),
+      note<T>("Operating the service: metrics, health, log format, a second service on the domain.", true),
+      group("observability", &T::observability, &observability_table, ""),
   }};
   return t;
 }

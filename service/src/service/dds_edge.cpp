@@ -2,8 +2,11 @@
 
 #include <exception>
 
+#include <unistd.h>
+
 #include <cstring>
 #include <set>
+#include <sstream>
 #include <utility>
 
 #include <fastdds/rtps/builtin/data/ReaderProxyData.h>
@@ -114,14 +117,52 @@ void check_endpoint_qos(const char* profile, const Qos& qos, dds::DurabilityQosP
 // It also notes the partition of every remote path or status reader (a vehicle's: access control
 // has checked that its permissions grant that partition), so that the dispatcher creates that
 // vehicle's writers before its first reply (its client waits for them to match).
+//
+// In every mode it also watches for other pullout_service participants on the domain (their user
+// data is kServiceUserData): two services both plan and publish for every vehicle, and the last
+// writer wins. Each one that appears is logged as a warning, and counted (other_services).
 class DdsEdge::Discovery final : public dds::DomainParticipantListener {
  public:
-  explicit Discovery(dds::GuardCondition& wake) : wake_(wake) {}
+  Discovery(dds::GuardCondition& wake, bool secure, int domain_id)
+      : wake_(wake), secure_(secure), domain_id_(domain_id) {}
+
+  void on_participant_discovery(dds::DomainParticipant* /*participant*/,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+    const auto& guid_prefix = info.info.m_guid.guidPrefix;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (info.status == Status::REMOVED_PARTICIPANT || info.status == Status::DROPPED_PARTICIPANT) {
+      const auto it = services_.find(guid_prefix);
+      if (it == services_.end()) return;
+      spdlog::info("the other pullout_service '{}' left DDS domain {} ({} other service(s) remain)", it->second,
+                   domain_id_, services_.size() - 1);
+      services_.erase(it);
+      return;
+    }
+    const auto& data = info.info.m_userData.data_vec();
+    const std::string user_data(data.begin(), data.end());
+    if (user_data != kServiceUserData || services_.count(guid_prefix) != 0) return;
+    const std::string name = info.info.m_participantName.to_string();
+    services_.emplace(guid_prefix, name);
+    std::ostringstream guid;
+    guid << guid_prefix;
+    spdlog::warn(
+        "another pullout_service is on DDS domain {}: participant '{}' (GUID prefix {}). Both plan and publish for "
+        "every vehicle and the last writer wins; stop one of them or give each its own domain "
+        "(observability.on_duplicate_service)",
+        domain_id_, name, guid.str());
+  }
+
+  // How many other pullout_service participants are on the domain now.
+  std::size_t other_services() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return services_.size();
+  }
 
   void on_subscriber_discovery(dds::DomainParticipant* /*participant*/,
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::ReaderDiscoveryInfo;
-    if (info.status == Status::REMOVED_READER) return;
+    if (!secure_ || info.status == Status::REMOVED_READER) return;
     const std::string topic = info.info.topicName().to_string();
     if (topic != kPathTopic && topic != kStatusTopic) return;
     const auto& names = info.info.m_qos.m_partition.names();
@@ -143,6 +184,7 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   void on_publisher_discovery(dds::DomainParticipant* /*participant*/,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo;
+    if (!secure_) return;  // only secure mode asks writer_partition_is
     const auto& guid = info.info.guid();
     std::lock_guard<std::mutex> lock(mutex_);
     if (info.status == Status::REMOVED_WRITER) {
@@ -164,9 +206,13 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   // Bounds the set between two dispatcher wake-ups (only authenticated participants add to it).
   static constexpr std::size_t kMaxPendingVehicles = 65536;
   dds::GuardCondition& wake_;
+  const bool secure_;
+  const int domain_id_;
   mutable std::mutex mutex_;
   std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> partitions_;
   std::set<std::string> pending_readers_;
+  // Other services: GUID prefix -> participant name.
+  std::map<eprosima::fastrtps::rtps::GuidPrefix_t, std::string> services_;
 };
 
 DdsEdge::DdsEdge(const DdsConfig& config) {
@@ -195,29 +241,36 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   }
   const std::string profiles = describe_profiles(config);
   secure_ = !config.security_dir.empty();
+  dds::DomainParticipantQos qos;
+  if (factory->get_participant_qos_from_profile(config.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
+    throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + profiles);
+  }
+  // Marks this participant as a pullout service for the other services' Discovery; a name that
+  // says where it runs, unless the profile gives one.
+  qos.user_data().data_vec(
+      std::vector<eprosima::fastrtps::rtps::octet>(kServiceUserData.begin(), kServiceUserData.end()));
+  if (qos.name().to_string().empty() || qos.name().to_string() == "RTPSParticipant") {
+    char host[256] = {};
+    if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+    qos.name(("pullout_service@" + std::string(host) + " pid " + std::to_string(getpid())).substr(0, 255));
+  }
   if (secure_) {
-    dds::DomainParticipantQos qos;
-    if (factory->get_participant_qos_from_profile(config.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
-      throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + profiles);
-    }
     try {
       idl::add_security_properties(config.security_dir, qos);
     } catch (const std::invalid_argument& e) {
       throw DdsSetupError(std::string("dds.security_dir: ") + e.what());
     }
-    discovery_ = std::make_unique<Discovery>(discovery_wake_);
-    participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
-    if (participant_ == nullptr) {
+  }
+  discovery_ = std::make_unique<Discovery>(discovery_wake_, secure_, config.domain_id);
+  participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
+  if (participant_ == nullptr) {
+    if (secure_) {
       throw DdsSetupError("cannot create the secure DDS participant with the credentials in " + config.security_dir +
                           " (profile '" + config.participant_profile + "' of " + profiles + ", domain " +
                           std::to_string(config.domain_id) + "): see the SECURITY errors of Fast DDS above");
     }
-  } else {
-    participant_ = factory->create_participant_with_profile(config.domain_id, config.participant_profile);
-    if (participant_ == nullptr) {
-      throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
-                          profiles + " on domain " + std::to_string(config.domain_id));
-    }
+    throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
+                        profiles + " on domain " + std::to_string(config.domain_id));
   }
 
   request_topic_ = create_topic(*participant_, kRequestTopic, idl::make_guarded_type<msg::PullOutRequestPubSubType>());
@@ -299,6 +352,8 @@ void DdsEdge::destroy() noexcept {
   std::lock_guard<std::mutex> lock(vehicle_writers_mutex_);
   vehicle_writers_.clear();  // deleted with the participant's entities
 }
+
+std::size_t DdsEdge::other_services() const { return discovery_ ? discovery_->other_services() : 0; }
 
 void DdsEdge::prepare_discovered_vehicles() {
   if (!secure_) return;

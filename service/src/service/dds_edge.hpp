@@ -28,6 +28,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -49,6 +50,9 @@ struct SampleInfo;
 }  // namespace eprosima::fastdds::dds
 
 namespace pullout::service {
+
+// The participant user data that marks a pullout service (other services look for it).
+inline constexpr std::string_view kServiceUserData = "pullout_service";
 
 class DdsSetupError : public std::runtime_error {
  public:
@@ -81,6 +85,10 @@ class DdsEdge final : public Outbox {
   // Secure mode: deletes the vehicle's own writers instead (its readers see the instances with
   // no writer). Thread-safe.
   bool forget_vehicle(const std::string& vehicle_id) override;
+
+  // How many other pullout_service participants (user data kServiceUserData) are on the domain
+  // now; each one that appears is logged as a warning. Thread-safe.
+  std::size_t other_services() const;
 
   // The smallest resource_limits.max_instances of the four endpoints (0: unlimited): the most
   // vehicles the service can hold sessions for.

@@ -34,6 +34,11 @@ bool PlanningQueue::push(PlanningJob job) {
   return replaced;
 }
 
+std::size_t PlanningQueue::depth() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return waiting_.size();
+}
+
 void PlanningQueue::stop() {
   {
     std::lock_guard<std::mutex> lock(mutex_);

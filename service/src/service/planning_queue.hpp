@@ -48,6 +48,9 @@ class PlanningQueue {
   // started yet. Ignored after stop().
   bool push(PlanningJob job);
 
+  // Jobs waiting for a worker (not the running ones).
+  std::size_t depth() const;
+
   // Drops the waiting jobs and joins the workers once their running jobs return (cancel those
   // first to make this quick). Idempotent.
   void stop();

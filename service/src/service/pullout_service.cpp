@@ -16,6 +16,7 @@
 #include "pullout/idl/convert.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/model/types.hpp"
+#include "pullout/version.hpp"
 
 namespace pullout::service {
 namespace dds = eprosima::fastdds::dds;
@@ -42,21 +43,33 @@ const char* outcome_name(PlanningResult::Outcome o) {
   return "?";
 }
 
-RegistryOptions registry_options(const ServiceConfig& service) {
+RegistryOptions registry_options(const ServiceConfig& service, ServiceMetrics* metrics) {
   RegistryOptions o;
   o.session.progress_timeout_s = service.progress_timeout_s;
   o.session_idle_timeout_s = service.session_idle_timeout_s;
   o.max_vehicles = service.max_vehicles;
+  if (metrics != nullptr) {
+    o.on_reply = [metrics](const PullOutStatus& status) { metrics->on_reply(status); };
+    o.on_evicted = [metrics](int reason) { metrics->on_eviction(static_cast<EvictionReason>(reason)); };
+  }
   return o;
+}
+
+std::unique_ptr<ServiceMetrics> make_metrics(const Config& config) {
+  if (!config.observability.metrics.enabled) return nullptr;
+  return std::make_unique<ServiceMetrics>(kVersionString);
 }
 
 }  // namespace
 
 PulloutService::PulloutService(const Config& config, std::shared_ptr<const LaneletMap> map)
     : config_(config),
+      metrics_(make_metrics(config)),
       dds_(config.dds),
       planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
-      registry_(planner_, dds_, registry_options(config.service)) {
+      registry_(planner_, dds_, registry_options(config.service, metrics_.get())) {
+  health_.config_loaded = true;  // load_config validated it
+  health_.dds_ready = true;      // DdsEdge throws unless the participant and every endpoint exist
   // Every session holds one instance on the path and on the status writer, and a vehicle that is
   // served has one on each reader: a profile with fewer instances than sessions stops answering
   // new vehicles without a word once full.
@@ -68,6 +81,12 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
                         ": lower max_vehicles or raise max_instances");
   }
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
+  health_.workers_running = true;
+  if (metrics_) {
+    const MetricsConfig& m = config_.observability.metrics;
+    http_ = std::make_unique<HttpEndpoint>(m.address, m.port, metrics_->registry(), health_);
+    spdlog::info("metrics and health on http://{}:{} (/metrics, /healthz, /readyz)", m.address, http_->port());
+  }
 }
 
 PulloutService::~PulloutService() { stop(); }
@@ -81,11 +100,13 @@ void PulloutService::stop() {
   // Exactly one caller joins; concurrent callers wait in call_once until it has finished (two
   // threads joining one std::thread is undefined behaviour).
   std::call_once(stop_once_, [this] {
+    health_.workers_running = false;  // /readyz says so while the threads stop
     stopping_ = true;
     shutdown_.set_trigger_value(true);
     if (dispatcher_.joinable()) dispatcher_.join();
     registry_.cancel_all();
     if (queue_) queue_->stop();
+    http_.reset();
   });
 }
 
@@ -105,6 +126,7 @@ void PulloutService::dispatch_loop() {
   waitset.attach_condition(shutdown_);
   if (dds_.secure()) waitset.attach_condition(dds_.discovery_condition());
   spdlog::debug("dispatcher running");
+  health_.beat();
 
   auto last_time_tick = std::chrono::steady_clock::now();
   while (!stopping_) {
@@ -115,6 +137,7 @@ void PulloutService::dispatch_loop() {
       spdlog::error("dispatcher: WaitSet::wait failed (code {})", rc());
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
+    health_.beat();
     dds_.prepare_discovered_vehicles();
     // Both readers are drained on every wake-up: cheap when empty, and it cannot miss data.
     take_requests();
@@ -123,6 +146,13 @@ void PulloutService::dispatch_loop() {
     if (now - last_time_tick >= kSessionTimePeriod) {
       last_time_tick = now;
       registry_.on_time();
+      const std::size_t others = dds_.other_services();
+      health_.other_services = static_cast<std::uint32_t>(others);
+      if (metrics_) {
+        metrics_->set_vehicles(registry_.size());
+        metrics_->set_queue_depth(queue_->depth());
+        metrics_->set_other_services(others);
+      }
       // Bounded like the sessions: entries older than the interval say nothing any more.
       for (auto it = progress_warned_.begin(); it != progress_warned_.end();) {
         it = now - it->second >= kProgressWarnInterval ? progress_warned_.erase(it) : std::next(it);
@@ -207,6 +237,7 @@ void PulloutService::instance_gone(InstanceNames& names, const dds::SampleInfo& 
 }
 
 void PulloutService::handle_request(const msg::PullOutRequest& sample) {
+  if (metrics_) metrics_->on_request();
   if (sample.vehicle_id().size() > kMaxVehicleIdBytes) {
     spdlog::warn("request {} dropped: vehicle_id of {} bytes cannot be answered (at most {})", sample.request_id(),
                  sample.vehicle_id().size(), kMaxVehicleIdBytes);

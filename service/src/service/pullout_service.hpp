@@ -24,6 +24,8 @@
 #include <fastdds/rtps/common/InstanceHandle.h>
 #include <fastdds/dds/core/condition/GuardCondition.hpp>
 
+#include "observability/http_endpoint.hpp"
+#include "observability/service_metrics.hpp"
 #include "pullout/config/config.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "service/dds_edge.hpp"
@@ -61,6 +63,11 @@ class PulloutService {
   // The planning budget for a request's deadline_ms [ms].
   double effective_deadline_ms(double requested_ms) const;
 
+  // Other pullout_service participants on the domain now (DdsEdge::other_services).
+  std::size_t other_services() const { return dds_.other_services(); }
+  // The HTTP port of /metrics, /healthz and /readyz; 0 when observability.metrics is off.
+  int http_port() const { return http_ ? http_->port() : 0; }
+
  private:
   void dispatch_loop();
   void take_requests();
@@ -78,6 +85,9 @@ class PulloutService {
   void run_job(PlanningJob& job);
 
   Config config_;
+  // First: the registry's and the queue's observers use them until those are gone.
+  HealthState health_;
+  std::unique_ptr<ServiceMetrics> metrics_;  // null when observability.metrics is off
   DdsEdge dds_;
   StartPlanner planner_;
   VehicleRegistry registry_;
@@ -96,6 +106,8 @@ class PulloutService {
   InstanceNames progress_instances_;
   // Last: destroyed (workers joined) before the registry and the DDS entities they use.
   std::unique_ptr<PlanningQueue> queue_;
+  // After the queue: serves /readyz about everything above; stopped first.
+  std::unique_ptr<HttpEndpoint> http_;
 };
 
 }  // namespace pullout::service

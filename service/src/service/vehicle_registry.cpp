@@ -17,6 +17,14 @@ namespace {
 
 double seconds(VehicleSession::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
+// The outcome class of a status for on_reply: -1 none yet (idle, planning).
+int outcome_class(ExecutionState s) {
+  if (s == ExecutionState::kRejected) return 0;
+  if (s == ExecutionState::kNoPath) return 1;
+  if (has_path(s)) return 2;
+  return -1;
+}
+
 // Driving a path: the vehicle may be moving on what the session checks.
 bool driving(const PullOutStatus& s) { return s.departed && s.state != ExecutionState::kCompleted; }
 
@@ -132,6 +140,7 @@ void VehicleRegistry::forget(Slot& slot, const std::string& vehicle_id, Eviction
     outbox_.forget_vehicle(vehicle_id);
   }
   evicted_count_.fetch_add(1);
+  if (options_.on_evicted) options_.on_evicted(static_cast<int>(reason));
   spdlog::info("vehicle '{}' evicted: {}; idle {:.1f} s, last request {} in state {}", vehicle_id, to_string(reason),
                seconds(now - last_input), last.request_id, pullout::to_string(last.state));
 }
@@ -158,6 +167,7 @@ void VehicleRegistry::reject_full(const PullOutRequest& request) {
   // no session.
   outbox_.forget_vehicle(request.vehicle_id);
   rejected_full_count_.fetch_add(1);
+  if (options_.on_reply) options_.on_reply(status);
   // One line per second at most: a flood of new ids must not flood the log.
   const auto now = Clock::now();
   ++full_since_log_;
@@ -202,6 +212,13 @@ std::optional<PlanningJob> VehicleRegistry::settle(Slot& slot, std::unique_lock<
   if (effects.status && !undeliverable) {
     effects.status->stamp_ns = now_ns();
     outbox_.publish_status(*effects.status);
+    const int outcome = outcome_class(effects.status->state);
+    if (options_.on_reply && outcome >= 0 &&
+        (effects.status->request_id != slot.replied_request_id || outcome != slot.replied_outcome)) {
+      slot.replied_request_id = effects.status->request_id;
+      slot.replied_outcome = outcome;
+      options_.on_reply(*effects.status);
+    }
   }
   publishing.unlock();
   if (undeliverable) {

@@ -62,6 +62,13 @@ struct RegistryOptions {
   std::size_t max_vehicles{2048};
   // The registry's time (sessions, idle times); tests inject a fake. Empty: steady_clock::now.
   std::function<VehicleSession::Clock::time_point()> clock;
+  // Observers for statistics (the service's metrics); empty: none. Called on the publishing
+  // thread, after the samples are written; they must be quick and must not call the registry.
+  //   on_reply:   the first status of a request with an outcome (rejected, no path, or a found
+  //               path), once per request and outcome, and every rejection for a full registry;
+  //   on_evicted: each eviction.
+  std::function<void(const PullOutStatus&)> on_reply;
+  std::function<void(int /*EvictionReason*/)> on_evicted;
 };
 
 // The reader a vehicle's instance lived on.
@@ -113,6 +120,9 @@ class VehicleRegistry {
     bool request_alive{false};
     bool progress_alive{false};
     bool evicted{false};  // removed from the map: publishes nothing more (guarded by mutex)
+    // The last request and outcome reported to on_reply (guarded by publish_mutex).
+    std::uint64_t replied_request_id{0};
+    int replied_outcome{-1};
   };
 
   std::shared_ptr<Slot> find(const std::string& vehicle_id) const;

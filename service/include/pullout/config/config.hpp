@@ -1,9 +1,10 @@
 // Loading and validating config/pullout.yaml.
 //
-// The file has five sections: `vehicle` (VehicleInfo fields without the unit suffix, e.g.
+// The file has six sections: `vehicle` (VehicleInfo fields without the unit suffix, e.g.
 // wheel_base), `start_planner` (StartPlannerParameters, Autoware's names), `service` (workers,
 // default deadline, request limits, log level), `dds` (domain id, XML profiles file, participant
-// profile) and `map` (the Lanelet2 map file; its content is loaded by the service, not here). Every
+// profile), `map` (the Lanelet2 map file; its content is loaded by the service, not here) and
+// `observability` (metrics and health endpoints, log format, a second service on the domain). Every
 // key is optional (the struct defaults apply) but an unknown key, a value of the wrong type or an
 // out-of-range value is an error. load_config() reports every problem at once.
 //
@@ -72,12 +73,30 @@ struct MapConfig {
   std::string path;
 };
 
+// The values of observability.log_format and observability.on_duplicate_service.
+inline constexpr std::array<const char*, 2> kLogFormats{"text", "json"};
+inline constexpr std::array<const char*, 2> kDuplicatePolicies{"warn", "exit"};
+
+// The Prometheus endpoint (/metrics) and the health endpoints (/healthz, /readyz) on one HTTP port.
+struct MetricsConfig {
+  bool enabled{false};
+  std::string address{"127.0.0.1"};  // IPv4 address to listen on; 0.0.0.0 = every interface
+  int port{9464};
+};
+
+struct ObservabilityConfig {
+  MetricsConfig metrics;
+  std::string log_format{"text"};            // one of kLogFormats
+  std::string on_duplicate_service{"warn"};  // one of kDuplicatePolicies
+};
+
 struct Config {
   VehicleInfo vehicle;
   StartPlannerParameters start_planner;
   ServiceConfig service;
   DdsConfig dds;
   MapConfig map;
+  ObservabilityConfig observability;
 };
 
 // Thrown by load_config / load_scenario with one line per problem: "<file>: <key path>: <problem>".
@@ -106,14 +125,18 @@ Config load_config(const std::string& path);
 //                             ADDRESS:PORT from it)
 //   PULLOUT_DDS_SECURITY_DIR  dds.security_dir: DDS Security credentials (the secure setup, with
 //                             any of the profiles)
+//   PULLOUT_METRICS_ENABLED   observability.metrics.enabled: true or false
+//   PULLOUT_METRICS_ADDRESS   observability.metrics.address: an IPv4 address
 struct EnvironmentVariable {
   const char* name;
   const char* key;  // the config key it overrides
 };
-inline constexpr std::array<EnvironmentVariable, 3> kEnvironmentVariables{{
+inline constexpr std::array<EnvironmentVariable, 5> kEnvironmentVariables{{
     {"PULLOUT_DOMAIN_ID", "dds.domain_id"},
     {"PULLOUT_DDS_PROFILE", "dds.profiles_file"},
     {"PULLOUT_DDS_SECURITY_DIR", "dds.security_dir"},
+    {"PULLOUT_METRICS_ENABLED", "observability.metrics.enabled"},
+    {"PULLOUT_METRICS_ADDRESS", "observability.metrics.address"},
 }};
 // The profile names PULLOUT_DDS_PROFILE accepts (files dds/<name>.xml in config/).
 inline constexpr std::array<const char*, 3> kDdsProfileNames{"loopback", "network", "discovery_client"};
