@@ -12,6 +12,7 @@
 #include <signal.h>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <exception>
 #include <memory>
@@ -113,7 +114,9 @@ int run(int argc, char** argv) {
   pullout::Config config;
   std::string config_error;
   try {
-    config = pullout::load_config(config_path);
+    // The file, then the environment's overrides (PULLOUT_DOMAIN_ID, PULLOUT_DDS_PROFILE, ...), then
+    // the command line's.
+    config = pullout::load_config(config_path, [](const char* name) { return std::getenv(name); });
   } catch (const pullout::ConfigError& e) {
     // One line per problem, already "<file>: <key>: <problem>".
     config_error = std::string("invalid config:\n") + e.what();
@@ -158,7 +161,7 @@ int run(int argc, char** argv) {
     pullout::service::PulloutService service(config, map);
     service.start();
     spdlog::info("pullout_service ready: domain {}, participant profile '{}' from {}, {} planning thread(s)",
-                 config.dds.domain_id, config.dds.participant_profile, config.dds.profiles_file,
+                 config.dds.domain_id, config.dds.participant_profile, pullout::describe_profiles(config.dds),
                  config.service.worker_threads);
     const bool exit_on_duplicate = config.observability.on_duplicate_service == "exit";
     const char* signal_name =

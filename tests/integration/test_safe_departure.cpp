@@ -253,7 +253,7 @@ TEST_F(SafeDeparture, ReSentRequestKeepsTheSegmentIndexOfALatchedMultiSegmentPat
 }
 
 TEST_F(SafeDeparture, TurnSignalIsOnForThePrepareTimeBeforeDeparture) {
-  // The shipped config with prepare_time_before_start: 2 s (profiles path made absolute).
+  // The shipped config with prepare_time_before_start: 2 s (and the profiles file given).
   std::ifstream in(default_config_path());
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const auto replace = [&](const std::string& from, const std::string& to) {
@@ -262,7 +262,7 @@ TEST_F(SafeDeparture, TurnSignalIsOnForThePrepareTimeBeforeDeparture) {
     text.replace(at, from.size(), to);
   };
   replace("prepare_time_before_start: 0.0", "prepare_time_before_start: 2.0");
-  replace("profiles_file: dds/loopback.xml", "profiles_file: " + loopback_profiles_path());
+  replace("profiles_file: \"\"", "profiles_file: " + loopback_profiles_path());
   start_service(temp_.write_file("pullout.yaml", text));
 
   const Scenario scenario = load_test_scenario("straight_shoulder");

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -74,15 +75,16 @@ void cross_key_problems(const Config& config, Problems& problems) {
   observability_problems(config.observability, problems);
 }
 
-// Resolves dds.profiles_file relative to the config file (the table has checked it is not empty).
-void resolve_dds(DdsConfig& d, const std::filesystem::path& config_dir, Problems& problems) {
+// Resolves dds.profiles_file relative to the config file; empty stays empty (the built-in
+// profiles). `name` is what the problem names: the key, or the variable that set it.
+void resolve_dds(DdsConfig& d, const std::filesystem::path& config_dir, const std::string& name, Problems& problems) {
   if (d.profiles_file.empty()) return;
   std::filesystem::path file(d.profiles_file);
   if (file.is_relative()) file = config_dir / file;
   file = file.lexically_normal();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) {
-    problems.push_back("dds.profiles_file: file not found: " + file.string());
+    problems.push_back(name + ": file not found: " + file.string());
     return;
   }
   d.profiles_file = file.string();
@@ -90,22 +92,105 @@ void resolve_dds(DdsConfig& d, const std::filesystem::path& config_dir, Problems
 
 // Resolves dds.security_dir relative to the config file and checks that it holds the five
 // credential files (pullout/idl/security.hpp).
-void resolve_security(DdsConfig& d, const std::filesystem::path& config_dir, Problems& problems) {
+void resolve_security(DdsConfig& d, const std::filesystem::path& config_dir, const std::string& name,
+                      Problems& problems) {
   if (d.security_dir.empty()) return;
   std::filesystem::path dir(d.security_dir);
   if (dir.is_relative()) dir = config_dir / dir;
   dir = dir.lexically_normal();
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) {
-    problems.push_back("dds.security_dir: directory not found: " + dir.string());
+    problems.push_back(name + ": directory not found: " + dir.string());
     return;
   }
-  for (const char* name : kSecurityFileNames) {
-    if (!std::filesystem::is_regular_file(dir / name, ec)) {
-      problems.push_back("dds.security_dir: " + (dir / name).string() + " not found");
+  for (const char* file : kSecurityFileNames) {
+    if (!std::filesystem::is_regular_file(dir / file, ec)) {
+      problems.push_back(name + ": " + (dir / file).string() + " not found");
     }
   }
   d.security_dir = dir.string();
+}
+
+const char* no_environment(const char* /*name*/) { return nullptr; }
+
+// The value of a set, non-empty variable.
+std::optional<std::string> variable(const Environment& env, const char* name) {
+  const char* value = env(name);
+  if (value == nullptr || *value == '\0') return std::nullopt;
+  return std::string(value);
+}
+
+// What a problem with a file or directory names: the variable that set it, or the key.
+struct Origins {
+  std::string profiles_file{"dds.profiles_file"};
+  std::string security_dir{"dds.security_dir"};
+};
+
+std::string joined_profile_names() {
+  std::string out;
+  for (const char* name : kDdsProfileNames) out.append(out.empty() ? "" : ", ").append(name);
+  return out;
+}
+
+// Applies kEnvironmentVariables onto `config`, appending one line per bad value.
+void apply_environment(Config& config, const Environment& env, Origins& origins, Problems& problems) {
+  DdsConfig& d = config.dds;
+  if (const auto v = variable(env, "PULLOUT_DOMAIN_ID")) {
+    const bool digits =
+        v->size() <= 3 && std::all_of(v->begin(), v->end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+    if (!digits || std::stoi(*v) > 232) {
+      problems.push_back("PULLOUT_DOMAIN_ID: must be an integer in [0, 232] (it overrides dds.domain_id), got '" + *v +
+                         "'");
+    } else {
+      d.domain_id = std::stoi(*v);
+    }
+  }
+  if (const auto v = variable(env, "PULLOUT_DDS_PROFILE")) {
+    const bool named =
+        std::any_of(kDdsProfileNames.begin(), kDdsProfileNames.end(), [&](const char* name) { return *v == name; });
+    const bool path = v->find('/') != std::string::npos || (v->size() > 4 && v->compare(v->size() - 4, 4, ".xml") == 0);
+    if (named) {
+      d.profiles_file = "dds/" + *v + ".xml";
+      origins.profiles_file = "PULLOUT_DDS_PROFILE=" + *v;
+      if (*v == "discovery_client" && !variable(env, "ROS_DISCOVERY_SERVER")) {
+        problems.push_back(
+            "PULLOUT_DDS_PROFILE: discovery_client needs ROS_DISCOVERY_SERVER, the discovery server's "
+            "ADDRESS:PORT (e.g. 10.0.0.1:11811)");
+      }
+    } else if (path) {
+      d.profiles_file = *v;
+      origins.profiles_file = "PULLOUT_DDS_PROFILE";
+    } else {
+      problems.push_back("PULLOUT_DDS_PROFILE: unknown profile '" + *v + "': one of " + joined_profile_names() +
+                         ", or the path of a Fast DDS XML profiles file");
+    }
+  }
+  if (const auto v = variable(env, "PULLOUT_DDS_SECURITY_DIR")) {
+    d.security_dir = *v;
+    origins.security_dir = "PULLOUT_DDS_SECURITY_DIR";
+  }
+  MetricsConfig& m = config.observability.metrics;
+  if (const auto v = variable(env, "PULLOUT_METRICS_ENABLED")) {
+    if (*v == "true" || *v == "false") {
+      m.enabled = *v == "true";
+    } else {
+      problems.push_back(
+          "PULLOUT_METRICS_ENABLED: must be true or false (it overrides "
+          "observability.metrics.enabled), got '" +
+          *v + "'");
+    }
+  }
+  if (const auto v = variable(env, "PULLOUT_METRICS_ADDRESS")) {
+    in_addr parsed{};
+    if (inet_pton(AF_INET, v->c_str(), &parsed) == 1) {
+      m.address = *v;
+    } else {
+      problems.push_back(
+          "PULLOUT_METRICS_ADDRESS: must be an IPv4 address such as 0.0.0.0 (it overrides "
+          "observability.metrics.address), got '" +
+          *v + "'");
+    }
+  }
 }
 
 }  // namespace
@@ -186,7 +271,9 @@ std::string documented_config(const Config& values) {
   return config_table::render(doc);
 }
 
-Config load_config(const std::string& path) {
+Config load_config(const std::string& path) { return load_config(path, no_environment); }
+
+Config load_config(const std::string& path, const Environment& env) {
   const YAML::Node doc = load_yaml_file(path);
   Config config;
   Problems problems;
@@ -194,14 +281,20 @@ Config load_config(const std::string& path) {
   if (root.valid()) {
     // Reading checks each key's type and allowed values and reports unknown keys.
     config_table::read_table(config_table::config_file_table(), root, config);
+    Origins origins;
+    apply_environment(config, env, origins, problems);
     cross_key_problems(config, problems);
     const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-    resolve_dds(config.dds, dir, problems);
-    resolve_security(config.dds, dir, problems);
+    resolve_dds(config.dds, dir, origins.profiles_file, problems);
+    resolve_security(config.dds, dir, origins.security_dir, problems);
     resolve_map(config.map, dir, problems);
   }
   if (!problems.empty()) throw ConfigError(path, std::move(problems));
   return config;
+}
+
+std::string describe_profiles(const DdsConfig& dds) {
+  return dds.profiles_file.empty() ? std::string("the built-in loopback profiles") : dds.profiles_file;
 }
 
 }  // namespace pullout

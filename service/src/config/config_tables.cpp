@@ -439,8 +439,9 @@ const Table<DdsConfig>& dds_table() {
   static const Table<T> t{{
       // The highest domain id the RTPS port mapping allows.
       field("domain_id", &T::domain_id, "", in(0, 232), "--domain overrides it"),
-      field("profiles_file", &T::profiles_file, "", NonEmpty{},
-            "Fast DDS XML profiles, relative to this file; dds/network.xml for real networks"),
+      field("profiles_file", &T::profiles_file, "", AnyValue{},
+            "Fast DDS XML profiles, relative to this file; empty = the built-in loopback-only profiles "
+            "(config/dds/loopback.xml, compiled in); dds/network.xml for real networks"),
       field("participant_profile", &T::participant_profile, "", NonEmpty{}, "a profile of that file"),
       field("security_dir", &T::security_dir, "", AnyValue{},
             "DDS Security credentials (ca.pem, cert.pem, key.pem, governance.p7s, permissions.p7s), relative to "

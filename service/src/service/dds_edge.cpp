@@ -36,6 +36,7 @@
 #include "pullout/idl/guarded_type.hpp"
 #include "pullout/idl/security.hpp"
 #include "pullout/model/names.hpp"
+#include "service/builtin_profiles.hpp"
 
 namespace pullout::service {
 namespace dds = eprosima::fastdds::dds;
@@ -265,13 +266,19 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   auto* factory = dds::DomainParticipantFactory::get_instance();
   // Fast DDS only logs a missing or malformed XML file and then silently uses its defaults (all
   // interfaces, shared memory): that must stop the service instead.
-  if (factory->load_XML_profiles_file(config.profiles_file) != ReturnCode_t::RETCODE_OK) {
+  if (config.profiles_file.empty()) {
+    const std::string xml(kBuiltinProfilesXml);
+    if (factory->load_XML_profiles_string(xml.c_str(), xml.size()) != ReturnCode_t::RETCODE_OK) {
+      throw DdsSetupError("cannot load the built-in DDS profiles");
+    }
+  } else if (factory->load_XML_profiles_file(config.profiles_file) != ReturnCode_t::RETCODE_OK) {
     throw DdsSetupError("cannot load DDS profiles file " + config.profiles_file);
   }
+  const std::string profiles = describe_profiles(config);
   secure_ = !config.security_dir.empty();
   dds::DomainParticipantQos qos;
   if (factory->get_participant_qos_from_profile(config.participant_profile, qos) != ReturnCode_t::RETCODE_OK) {
-    throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + config.profiles_file);
+    throw DdsSetupError("no participant profile '" + config.participant_profile + "' in " + profiles);
   }
   // Marks this participant as a pullout service for the other services' Discovery; a name that
   // says where it runs, unless the profile gives one.
@@ -296,11 +303,11 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   if (participant_ == nullptr) {
     if (secure_) {
       throw DdsSetupError("cannot create the secure DDS participant with the credentials in " + config.security_dir +
-                          " (profile '" + config.participant_profile + "' of " + config.profiles_file + ", domain " +
+                          " (profile '" + config.participant_profile + "' of " + profiles + ", domain " +
                           std::to_string(config.domain_id) + "): see the SECURITY errors of Fast DDS above");
     }
     throw DdsSetupError("cannot create the DDS participant from profile '" + config.participant_profile + "' of " +
-                        config.profiles_file + " on domain " + std::to_string(config.domain_id));
+                        profiles + " on domain " + std::to_string(config.domain_id));
   }
 
   request_topic_ = create_topic(*participant_, kRequestTopic, idl::make_guarded_type<msg::PullOutRequestPubSubType>());
@@ -317,7 +324,7 @@ void DdsEdge::create_entities(const DdsConfig& config) {
 
   const auto missing_profile = [&](const char* what, const char* profile) {
     return DdsSetupError(std::string("cannot create the ") + what + " from profile '" + profile + "' (is it in " +
-                         config.profiles_file + "?)");
+                         profiles + "?)");
   };
   // Readers and writers are created without listeners: samples are taken on the dispatcher thread.
   const auto reader = [&](dds::Topic* topic, const char* what, const char* profile) {

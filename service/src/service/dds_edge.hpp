@@ -70,7 +70,8 @@ using idl::kStatusWriterProfile;
 
 class DdsEdge final : public Outbox {
  public:
-  // `config.profiles_file` must name a readable Fast DDS XML file (load_config resolves it).
+  // `config.profiles_file` must name a readable Fast DDS XML file (load_config resolves it), or be
+  // empty: the built-in profiles (builtin_profiles.hpp).
   explicit DdsEdge(const DdsConfig& config);
   ~DdsEdge() override;
   DdsEdge(const DdsEdge&) = delete;

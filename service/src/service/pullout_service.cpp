@@ -77,7 +77,7 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
   if (capacity > 0 && config.service.max_vehicles > static_cast<std::size_t>(capacity)) {
     throw DdsSetupError("service.max_vehicles = " + std::to_string(config.service.max_vehicles) +
                         " exceeds resource_limits.max_instances = " + std::to_string(capacity) +
-                        " of the DDS profiles in " + config.dds.profiles_file +
+                        " of the DDS profiles in " + describe_profiles(config.dds) +
                         ": lower max_vehicles or raise max_instances");
   }
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });

@@ -16,6 +16,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -32,8 +33,10 @@ namespace pullout {
 // Units, allowed values and comments of these structs' members are in the config tables.
 struct DdsConfig {
   int domain_id{0};
-  // load_config resolves it relative to the config file and checks that it exists.
-  std::string profiles_file{"dds/loopback.xml"};
+  // Fast DDS XML profiles file; load_config resolves it relative to the config file and checks
+  // that it exists. Empty: the built-in profiles, which are config/dds/loopback.xml compiled into
+  // the service (loopback only), so a config file needs no profiles file beside it.
+  std::string profiles_file;
   std::string participant_profile{"pullout_participant"};
   // DDS Security credentials of the service (a directory with kSecurityFileNames; load_config
   // resolves it relative to the config file). Empty: no security. When set, every vehicle's
@@ -109,6 +112,45 @@ class ConfigError : public std::runtime_error {
 // Loads and validates a config file. Throws ConfigError (every problem) or if the file cannot be
 // read or parsed.
 Config load_config(const std::string& path);
+
+// The environment variables that override keys of the config file (the container image is
+// configured with them): the file stays the base, a set variable replaces its key. Checked like the
+// key, each problem naming the variable. An empty variable counts as unset.
+//   PULLOUT_DOMAIN_ID         dds.domain_id: an integer in [0, 232]
+//   PULLOUT_DDS_PROFILE       dds.profiles_file: a profile name, loopback, network or
+//                             discovery_client (the file dds/<name>.xml beside the config file), or
+//                             the path of an XML file (relative to the config file; e.g. a copy of
+//                             dds/initial_peers.xml with the peers filled in); discovery_client
+//                             also needs ROS_DISCOVERY_SERVER (Fast DDS reads the server's
+//                             ADDRESS:PORT from it)
+//   PULLOUT_DDS_SECURITY_DIR  dds.security_dir: DDS Security credentials (the secure setup, with
+//                             any of the profiles)
+//   PULLOUT_METRICS_ENABLED   observability.metrics.enabled: true or false
+//   PULLOUT_METRICS_ADDRESS   observability.metrics.address: an IPv4 address
+struct EnvironmentVariable {
+  const char* name;
+  const char* key;  // the config key it overrides
+};
+inline constexpr std::array<EnvironmentVariable, 5> kEnvironmentVariables{{
+    {"PULLOUT_DOMAIN_ID", "dds.domain_id"},
+    {"PULLOUT_DDS_PROFILE", "dds.profiles_file"},
+    {"PULLOUT_DDS_SECURITY_DIR", "dds.security_dir"},
+    {"PULLOUT_METRICS_ENABLED", "observability.metrics.enabled"},
+    {"PULLOUT_METRICS_ADDRESS", "observability.metrics.address"},
+}};
+// The profile names PULLOUT_DDS_PROFILE accepts (files dds/<name>.xml in config/).
+inline constexpr std::array<const char*, 3> kDdsProfileNames{"loopback", "network", "discovery_client"};
+
+// Looks up an environment variable: its value, or nullptr when unset (std::getenv's contract).
+using Environment = std::function<const char*(const char*)>;
+
+// load_config, then the overrides of kEnvironmentVariables looked up in `env` (pass
+// `[](const char* n) { return std::getenv(n); }` for the process's environment). Throws
+// ConfigError with every problem of the file and of the variables.
+Config load_config(const std::string& path, const Environment& env);
+
+// "the built-in loopback profiles" or the profiles file's path: for messages.
+std::string describe_profiles(const DdsConfig& dds);
 
 // Applies a YAML mapping of start_planner parameters (Autoware names) onto `params`, appending one
 // "<prefix>.<key>: <problem>" line per problem. Used by load_config and by scenario files'
