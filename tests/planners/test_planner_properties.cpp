@@ -359,6 +359,7 @@ const char* const kExpectationScenarios[] = {"straight_shoulder",
                                              "car_close_ahead",
                                              "full_search",
                                              "map_shoulder",
+                                             "map_lane_change_route",
                                              "clothoid_only",
                                              "single_lane_street",
                                              "single_lane_street_left_hand"};
