@@ -42,7 +42,7 @@ std::string load_average() {
 struct Row {
   std::string name;
   std::vector<PlannerType> priority;
-  bool alone{true};  // current pose only, no freespace; else the shipped configuration
+  bool alone{true};                  // current pose only, no freespace; else the shipped configuration
   std::size_t expected_segments{0};  // 0: any
   std::size_t lanelets_passed{0};
   std::size_t cases_passed{0};
@@ -95,7 +95,8 @@ int main(int argc, char** argv) {
         for (int k = 0; k < rounds; ++k) {
           const auto t0 = std::chrono::steady_clock::now();
           const pullout::PlanningResult result = planner.plan(r, pullout::StopCondition());
-          row.times_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+          row.times_ms.push_back(
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
           ok = result.outcome == pullout::PlanningResult::Outcome::kFound &&
                (row.expected_segments == 0 || result.path.partial_paths.size() == row.expected_segments);
         }

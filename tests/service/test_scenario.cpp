@@ -107,8 +107,7 @@ TEST(Scenario, EveryScenarioInTheSuiteLoads) {
     try {
       const Scenario s = load_scenario(entry.path().string());
       // Inline lanes, a route on the scenario's map, or a grid for a pure freespace problem.
-      EXPECT_TRUE(!s.request.lanes.empty() || (s.map && has_route(s.request)) ||
-                  s.request.occupancy_grid.has_value())
+      EXPECT_TRUE(!s.request.lanes.empty() || (s.map && has_route(s.request)) || s.request.occupancy_grid.has_value())
           << entry.path();
     } catch (const ConfigError& e) {
       ADD_FAILURE() << e.what();

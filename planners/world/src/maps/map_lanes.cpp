@@ -165,7 +165,8 @@ std::vector<RequestIssue> check_route_ids(const LaneletMap& map, const std::vect
         if (!joined) {
           issues.push_back({field, "lanelet " + std::to_string(route[i]) + " does not follow lanelet " +
                                        std::to_string(map.lanelet(*prev).id) + " (route_lanelet_ids[" +
-                                       std::to_string(i - 1) + "]) nor a lane-change neighbour of it: the route is "
+                                       std::to_string(i - 1) +
+                                       "]) nor a lane-change neighbour of it: the route is "
                                        "not connected"});
         }
       }
@@ -210,8 +211,8 @@ std::vector<RequestIssue> check_route_segments(const LaneletMap& map, const std:
       if (idx) segment.primitives.push_back(*idx);
     }
     if (!preferred_listed) {
-      issues.push_back({field + ".preferred_primitive", "lanelet " + std::to_string(in.preferred_id) +
-                                                            " is not among the segment's primitives"});
+      issues.push_back({field + ".preferred_primitive",
+                        "lanelet " + std::to_string(in.preferred_id) + " is not among the segment's primitives"});
     }
     if (segment.primitives.empty()) continue;
     if (!segments.empty() && segments.size() == i && !follows(map, segments.back().primitives, segment.primitives)) {
@@ -228,7 +229,8 @@ std::vector<RequestIssue> check_route_segments(const LaneletMap& map, const std:
 // segments (the preferred one first), as far as the route goes that way.
 std::deque<std::size_t> route_chain(const LaneletMap& map, const std::vector<MapSegment>& segments, std::size_t at,
                                     std::size_t current) {
-  const auto pick = [&](const std::vector<std::size_t>& links, const MapSegment& segment) -> std::optional<std::size_t> {
+  const auto pick = [&](const std::vector<std::size_t>& links,
+                        const MapSegment& segment) -> std::optional<std::size_t> {
     if (contains(links, segment.preferred) && contains(segment.primitives, segment.preferred)) return segment.preferred;
     for (std::size_t p : segment.primitives) {
       if (contains(links, p)) return p;

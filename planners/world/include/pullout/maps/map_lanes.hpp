@@ -46,8 +46,8 @@ struct MapLaneOptions {
 
 struct MapLanes {
   std::vector<Lane> lanes;
-  std::vector<std::int64_t> road_ids;      // the road lanes, in driving order
-  std::vector<std::int64_t> pull_out_ids;  // the shoulder sequence, in driving order; empty: the road lanes
+  std::vector<std::int64_t> road_ids;       // the road lanes, in driving order
+  std::vector<std::int64_t> pull_out_ids;   // the shoulder sequence, in driving order; empty: the road lanes
   std::vector<std::int64_t> neighbour_ids;  // lane-change neighbours from the route's segments along the road
   std::vector<RequestIssue> issues;
 };
