@@ -10,7 +10,7 @@ namespace pullout::bench {
 
 struct Summary {
   std::size_t n{0};
-  double p50{0}, p90{0}, p99{0}, max{0};
+  double p50{0}, p90{0}, p95{0}, p99{0}, max{0};
 };
 
 // Nearest rank: the smallest sample with at least q of the samples at or below it.
@@ -25,6 +25,7 @@ inline Summary summarize(std::vector<double> v) {
   };
   s.p50 = rank(0.50);
   s.p90 = rank(0.90);
+  s.p95 = rank(0.95);
   s.p99 = rank(0.99);
   s.max = v.back();
   return s;

@@ -155,8 +155,12 @@ struct LegendEntry {
 };
 
 bool on_route(const PullOutRequest& request, const Lane& lane) {
-  return std::find(request.route_lanelet_ids.begin(), request.route_lanelet_ids.end(), lane.id) !=
-         request.route_lanelet_ids.end();
+  const auto listed = [&lane](const std::vector<std::int64_t>& ids) {
+    return std::find(ids.begin(), ids.end(), lane.id) != ids.end();
+  };
+  return listed(request.route_lanelet_ids) ||
+         std::any_of(request.route_segments.begin(), request.route_segments.end(),
+                     [&](const RouteSegment& s) { return s.preferred_id == lane.id || listed(s.primitive_ids); });
 }
 
 std::vector<LegendEntry> legend_entries(const PullOutRequest& request, const PullOutPath* path,

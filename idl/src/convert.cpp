@@ -268,6 +268,27 @@ std::optional<OccupancyGrid> checked_grid(const msg::OccupancyGrid& in, IssueSin
   return out;
 }
 
+// A route primitive is a lanelet: Autoware names its type "lane"; empty is taken as a lanelet too.
+std::int64_t checked_primitive(const msg::LaneletPrimitive& in, const std::string& field, IssueSink& sink) {
+  const std::string& type = in.primitive_type();
+  if (!type.empty() && type != "lane") {
+    constexpr std::size_t kShown = 32;
+    sink.add(field + ".primitive_type", "\"" + type.substr(0, kShown) + (type.size() > kShown ? "..." : "") +
+                                            "\" is not a lanelet: expected \"lane\" (or empty)");
+  }
+  return in.id();
+}
+
+RouteSegment checked_segment(const msg::LaneletSegment& in, const std::string& field, IssueSink& sink) {
+  RouteSegment out;
+  out.preferred_id = checked_primitive(in.preferred_primitive(), field + ".preferred_primitive", sink);
+  out.primitive_ids.reserve(in.primitives().size());
+  for (std::size_t j = 0; j < in.primitives().size(); ++j) {
+    out.primitive_ids.push_back(checked_primitive(in.primitives()[j], indexed(field + ".primitives", j), sink));
+  }
+  return out;
+}
+
 void check_vehicle_id(const std::string& id, IssueSink& sink) {
   if (id.empty()) sink.add("vehicle_id", "must not be empty");
   if (id.size() > kMaxVehicleIdBytes) {
@@ -332,6 +353,19 @@ msg::PullOutRequest to_msg(const PullOutRequest& in) {
   out.lanes().reserve(in.lanes.size());
   for (const auto& lane : in.lanes) out.lanes().push_back(lane_to_msg(lane));
   out.route_lanelet_ids(in.route_lanelet_ids);
+  out.route_segments().reserve(in.route_segments.size());
+  for (const auto& segment : in.route_segments) {
+    msg::LaneletSegment m;
+    m.preferred_primitive().id(segment.preferred_id);
+    m.preferred_primitive().primitive_type("lane");
+    for (const std::int64_t id : segment.primitive_ids) {
+      msg::LaneletPrimitive p;
+      p.id(id);
+      p.primitive_type("lane");
+      m.primitives().push_back(std::move(p));
+    }
+    out.route_segments().push_back(std::move(m));
+  }
   out.objects().reserve(in.objects.size());
   for (const auto& object : in.objects) out.objects().push_back(object_to_msg(object));
   out.occupancy_grid(grid_to_msg(in.occupancy_grid));
@@ -364,6 +398,10 @@ PullOutRequest from_msg(const msg::PullOutRequest& in, std::vector<RequestIssue>
     out.lanes.push_back(checked_lane(in.lanes()[i], indexed("lanes", i), sink));
   }
   out.route_lanelet_ids = in.route_lanelet_ids();
+  out.route_segments.reserve(in.route_segments().size());
+  for (std::size_t i = 0; i < in.route_segments().size(); ++i) {
+    out.route_segments.push_back(checked_segment(in.route_segments()[i], indexed("route_segments", i), sink));
+  }
   out.objects.reserve(in.objects().size());
   for (std::size_t i = 0; i < in.objects().size(); ++i) {
     out.objects.push_back(checked_object(in.objects()[i], indexed("objects", i), sink));

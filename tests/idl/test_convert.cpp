@@ -233,6 +233,37 @@ TEST(Convert, UnknownEnumeratorsAreIssues) {
   EXPECT_TRUE(has_issue(issues, "overrides.search_policy")) << dump(issues);
 }
 
+// An Autoware route's segments cross the wire as LaneletSegment / LaneletPrimitive.
+TEST(Convert, RouteSegmentsRoundTrip) {
+  PullOutRequest in = sample_request();
+  in.route_lanelet_ids.clear();
+  in.route_segments = {{4618, {4618, 4619}}, {4635, {4635}}};
+  std::vector<RequestIssue> issues;
+  const msg::PullOutRequest m = to_msg(in);
+  ASSERT_EQ(m.route_segments().size(), 2u);
+  EXPECT_EQ(m.route_segments()[0].preferred_primitive().id(), 4618);
+  EXPECT_EQ(m.route_segments()[0].primitives()[1].primitive_type(), "lane");
+  const PullOutRequest out = from_msg(m, issues);
+  EXPECT_TRUE(issues.empty()) << dump(issues);
+  ASSERT_EQ(out.route_segments.size(), 2u);
+  EXPECT_EQ(out.route_segments[0].preferred_id, 4618);
+  EXPECT_EQ(out.route_segments[0].primitive_ids, (std::vector<std::int64_t>{4618, 4619}));
+  EXPECT_EQ(out.route_segments[1].primitive_ids, (std::vector<std::int64_t>{4635}));
+  EXPECT_TRUE(out.route_lanelet_ids.empty());
+}
+
+TEST(Convert, RoutePrimitiveThatIsNoLaneletIsAnIssue) {
+  PullOutRequest in = sample_request();
+  in.route_segments = {{4618, {4618, 4619}}};
+  msg::PullOutRequest m = to_msg(in);
+  m.route_segments()[0].primitives()[1].primitive_type("crosswalk");
+  m.route_segments()[0].preferred_primitive().primitive_type("");  // empty: a lanelet
+  std::vector<RequestIssue> issues;
+  from_msg(m, issues);
+  ASSERT_EQ(issues.size(), 1u) << dump(issues);
+  EXPECT_TRUE(has_issue(issues, "route_segments[0].primitives[1].primitive_type")) << dump(issues);
+}
+
 TEST(Convert, GridSizeMismatchAndNegativeDeadline) {
   msg::PullOutRequest m = to_msg(sample_request());
   m.occupancy_grid().data().pop_back();

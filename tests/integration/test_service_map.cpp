@@ -78,6 +78,34 @@ TEST_F(MapService, RouteRequestIsAnsweredAndABadRouteIsRejectedNamingTheField) {
   EXPECT_TRUE(path_again->found);
 }
 
+// An Autoware route (segments with lane-change neighbours) crosses the wire and plans on the
+// service's map; a segment that does not connect is rejected naming it.
+TEST_F(MapService, RouteSegmentsRequestIsAnswered) {
+  start_service(temp_.write_file("two_lane.yaml", "dds:\n  profiles_file: " + loopback_profiles_path() +
+                                                      "\nmap:\n  path: " + source_path("tests/maps/two_lane_road.osm") +
+                                                      "\n"));
+  const Scenario scenario = load_test_scenario("map_lane_change_route");
+  ASSERT_EQ(scenario.request.route_segments.size(), 3u);
+  auto client = connect("int-map-segments");
+  ASSERT_NE(client, nullptr);
+  const std::uint64_t id = client->send(scenario.request);
+  const auto path = client->wait_for_path(id, kReplyTimeout);
+  ASSERT_TRUE(path) << "no path for the route segments\n" << service_stderr();
+  expect_found_path_invariants(*path);
+  EXPECT_TRUE(path->found);
+
+  auto other = connect("int-map-segments-bad");
+  ASSERT_NE(other, nullptr);
+  PullOutRequest bad = scenario.request;
+  bad.route_segments.erase(bad.route_segments.begin() + 1);  // 111/121 then 113/123: a gap
+  const std::uint64_t bad_id = other->send(bad);
+  const auto rejected = other->wait_for_status(
+      bad_id, [](const PullOutStatus& s) { return is_state(s, ExecutionState::kRejected); }, kReplyTimeout);
+  ASSERT_TRUE(rejected) << "no REJECTED status for the disconnected route";
+  EXPECT_NE(rejected->error.find("route_segments[1]"), std::string::npos) << rejected->error;
+  EXPECT_NE(rejected->error.find("not connected"), std::string::npos) << rejected->error;
+}
+
 // A route request is checked for traffic on the lanes picked on the map (the service used to build
 // its safety check from the request's inline lanes, which a route request does not have).
 TEST_F(MapService, ARouteRequestHoldsForAFastCarFromBehind) {

@@ -10,6 +10,11 @@ lane 301 (y in [-5.25, -1.75], driving -x) whose right bound is drawn against it
 crosswalk lanelet 401 at x 150..154; road 103's right bound is drawn backwards too; a traffic light
 regulatory element and a way with a dangling node reference that no lanelet uses. Speed limits
 are km/h as in Autoware's maps. Nodes carry local_x/local_y and lat/lon.
+
+two_lane_road.osm: a 200 m two-lane one-way road along +x (right-hand traffic): the right lane
+111 (x 0..60), 112 (60..120), 113 (120..200) in y [-1.75, 1.75], the left lane 121, 122, 123 in
+y [1.75, 5.25] beside them (sharing the bound ways: lane-change neighbours), and a 3 m
+road_shoulder 211 (0..60), 212 (60..120) on the right in y [-4.75, -1.75].
 """
 import math
 import os
@@ -111,6 +116,26 @@ def straight_shoulder(path):
     m.write(path)
 
 
+def two_lane_road(path):
+    m = Osm()
+    dashed = [("type", "line_thin"), ("subtype", "dashed")]
+    solid = [("type", "line_thin"), ("subtype", "solid")]
+    spans = [(0, 0, 60), (1, 60, 120), (2, 120, 200)]
+    middle = {k: m.way(line(x0, x1, 1.75), dashed) for k, x0, x1 in spans}
+    right_edge = {k: m.way(line(x0, x1, -1.75), solid) for k, x0, x1 in spans}
+    left_edge = {k: m.way(line(x0, x1, 5.25), solid) for k, x0, x1 in spans}
+    road = [("subtype", "road"), ("speed_limit", "50"), ("location", "urban"), ("one_way", "yes")]
+    for k, _, _ in spans:
+        m.lanelet(111 + k, middle[k], right_edge[k], road)
+        m.lanelet(121 + k, left_edge[k], middle[k], road)
+    for k, x0, x1 in spans[:2]:
+        outer = m.way(line(x0, x1, -4.75), solid)
+        m.lanelet(211 + k, right_edge[k], outer,
+                  [("subtype", "road_shoulder"), ("speed_limit", "10"), ("location", "urban"), ("one_way", "yes")])
+    m.write(path)
+
+
 if __name__ == "__main__":
     here = os.path.dirname(os.path.abspath(__file__))
     straight_shoulder(os.path.join(here, "straight_shoulder.osm"))
+    two_lane_road(os.path.join(here, "two_lane_road.osm"))

@@ -209,6 +209,90 @@ TEST_F(OwnMap, BadRoutesAreRejectedNamingTheField) {
                         "no Lanelet2 map is loaded"));
 }
 
+// ---- routes with lane-change neighbours: the project's own two-lane map ----
+
+const std::string kTwoLaneMap = std::string(PULLOUT_SOURCE_DIR) + "/tests/maps/two_lane_road.osm";
+
+class TwoLaneMap : public OwnMap {
+ protected:
+  void SetUp() override {
+    map_ = load_lanelet_map(kTwoLaneMap);
+    config_ = default_config();
+  }
+};
+
+PullOutRequest segment_request(std::vector<RouteSegment> segments, Pose2 ego, Pose2 goal) {
+  PullOutRequest r = route_request({}, ego, goal);
+  r.route_segments = std::move(segments);
+  return r;
+}
+
+// The shoulder on the right of the right lane; the route's preferred lane changes to the left lane.
+const Pose2 kOnTheShoulder{20.0, -3.25, 0.0};
+const Pose2 kLeftLaneEnd{190.0, 3.5, 0.0};
+const std::vector<RouteSegment> kLaneChangeRoute{{111, {111, 121}}, {122, {112, 122}}, {123, {113, 123}}};
+
+TEST_F(TwoLaneMap, RouteSegmentsWithLaneChangeNeighboursPlan) {
+  const PullOutRequest r = segment_request(kLaneChangeRoute, kOnTheShoulder, kLeftLaneEnd);
+  const MapLanes lanes = select_map_lanes(*map_, r, options());
+  ASSERT_TRUE(lanes.issues.empty()) << dump(lanes.issues);
+  // The road lanes follow successors through the segments; the neighbours are lanes too.
+  EXPECT_EQ(lanes.road_ids, (std::vector<std::int64_t>{111, 112, 113}));
+  EXPECT_EQ(lanes.pull_out_ids, (std::vector<std::int64_t>{211, 212}));
+  EXPECT_EQ(lanes.neighbour_ids, (std::vector<std::int64_t>{121, 122, 123}));
+  EXPECT_EQ(lanes.lanes.size(), 8u);
+  const PlanningResult result = planner().plan(r, StopCondition());
+  expect_drivable(result, r, *map_, config_.vehicle, config_.start_planner);
+  ASSERT_TRUE(result.world);
+  const auto has_lane = [&](std::int64_t id) {
+    return std::any_of(result.world->lanes.begin(), result.world->lanes.end(),
+                       [id](const Lane& l) { return l.id == id; });
+  };
+  EXPECT_TRUE(has_lane(121)) << "the departure checks use the segments' neighbours";
+  // The same route as ids: a lanelet after a lane change (122 follows 121, the neighbour of 111)
+  // was rejected as "not connected"; it plans, the neighbour joining the lanes.
+  const PullOutRequest by_ids = route_request({111, 122, 123}, kOnTheShoulder, kLeftLaneEnd);
+  const MapLanes id_lanes = select_map_lanes(*map_, by_ids, options());
+  ASSERT_TRUE(id_lanes.issues.empty()) << dump(id_lanes.issues);
+  EXPECT_EQ(id_lanes.neighbour_ids, (std::vector<std::int64_t>{121}));
+  expect_drivable(planner().plan(by_ids, StopCondition()), by_ids, *map_, config_.vehicle, config_.start_planner);
+  // Plain ids along one lane take no neighbour.
+  const MapLanes plain = select_map_lanes(*map_, route_request({111, 112, 113}, kOnTheShoulder, {}), options());
+  EXPECT_TRUE(plain.neighbour_ids.empty());
+}
+
+TEST_F(TwoLaneMap, DisconnectedRoutesAreStillRejectedNamingTheField) {
+  const auto issues_of = [&](const PullOutRequest& r) { return planner().plan(r, StopCondition()).issues; };
+  // Ids: 123 follows neither 111 nor its neighbour 121.
+  auto i = issues_of(route_request({111, 123}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_lanelet_ids[1]", "the route is not connected")) << dump(i);
+  // Segments: nothing of segment 1 follows segment 0.
+  i = issues_of(segment_request({{111, {111, 121}}, {123, {113, 123}}}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_segments[1]", "the route is not connected")) << dump(i);
+  // A primitive that is not beside the preferred lanelet.
+  i = issues_of(segment_request({{111, {111, 112}}}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_segments[0].primitives[1]", "not a lane-change neighbour")) << dump(i);
+  // The preferred lanelet missing from the primitives; unknown ids; shoulders.
+  i = issues_of(segment_request({{111, {121}}}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_segments[0].preferred_primitive", "not among the segment's primitives")) << dump(i);
+  i = issues_of(segment_request({{111, {111, 4242}}}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_segments[0].primitives[1]", "unknown lanelet id 4242")) << dump(i);
+  i = issues_of(segment_request({{4242, {}}}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_segments[0].preferred_primitive", "unknown lanelet id 4242")) << dump(i);
+  i = issues_of(segment_request({{111, {111, 211}}}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_segments[0].primitives[1]", "not a road")) << dump(i);
+  i = issues_of(segment_request({{111, {111}}, {112, {112, 111}}}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_segments[1].primitives[1]", "listed twice")) << dump(i);
+  // Both forms at once.
+  PullOutRequest both = segment_request(kLaneChangeRoute, kOnTheShoulder, kLeftLaneEnd);
+  both.route_lanelet_ids = {111};
+  i = issues_of(both);
+  EXPECT_TRUE(has_issue(i, "route_segments", "not both")) << dump(i);
+  // Far from the vehicle.
+  i = issues_of(segment_request({{113, {113, 123}}}, kOnTheShoulder, kLeftLaneEnd));
+  EXPECT_TRUE(has_issue(i, "route_segments", "does not pass by the vehicle")) << dump(i);
+}
+
 // ---- the real Autoware maps (../shared/maps) ----
 
 struct SharedMap {

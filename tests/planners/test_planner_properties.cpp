@@ -349,19 +349,13 @@ TEST_P(ScenarioExpectations, MatchTheFile) {
 }
 
 // The map scenarios too (their path properties are checked in test_map_planning.cpp).
-const char* const kExpectationScenarios[] = {"straight_shoulder",
-                                             "curved_road",
-                                             "parked_car_ahead",
-                                             "boxed_in",
-                                             "parallel_spot",
-                                             "perpendicular_bay",
-                                             "parallel_spot_reverse",
-                                             "car_close_ahead",
-                                             "full_search",
-                                             "map_shoulder",
-                                             "clothoid_only",
-                                             "single_lane_street",
-                                             "single_lane_street_left_hand"};
+const char* const kExpectationScenarios[] = {"straight_shoulder",     "curved_road",
+                                             "parked_car_ahead",      "boxed_in",
+                                             "parallel_spot",         "perpendicular_bay",
+                                             "parallel_spot_reverse", "car_close_ahead",
+                                             "full_search",           "map_shoulder",
+                                             "map_lane_change_route", "clothoid_only",
+                                             "single_lane_street",    "single_lane_street_left_hand"};
 INSTANTIATE_TEST_SUITE_P(Bundled, ScenarioExpectations, ::testing::ValuesIn(kExpectationScenarios));
 
 TEST(ScenarioSpecifics, CarCloseAheadReversesFirst) {

@@ -107,8 +107,7 @@ TEST(Scenario, EveryScenarioInTheSuiteLoads) {
     try {
       const Scenario s = load_scenario(entry.path().string());
       // Inline lanes, a route on the scenario's map, or a grid for a pure freespace problem.
-      EXPECT_TRUE(!s.request.lanes.empty() || (s.map && !s.request.route_lanelet_ids.empty()) ||
-                  s.request.occupancy_grid.has_value())
+      EXPECT_TRUE(!s.request.lanes.empty() || (s.map && has_route(s.request)) || s.request.occupancy_grid.has_value())
           << entry.path();
     } catch (const ConfigError& e) {
       ADD_FAILURE() << e.what();
@@ -236,6 +235,27 @@ TEST(Scenario, MapAndRouteProblems) {
   // A route without a map is for a service that has the map.
   p = problems_of(std::string(kPoses) + "route: [101, 102]\n");
   EXPECT_TRUE(p.empty()) << dump(p);
+}
+
+// route: as Autoware route segments, {preferred, primitives}.
+TEST(Scenario, RouteAsSegments) {
+  const Scenario sc = load_scenario(kScenarioDir + "/map_lane_change_route.yaml");
+  ASSERT_TRUE(sc.map);
+  EXPECT_TRUE(sc.request.route_lanelet_ids.empty());
+  ASSERT_EQ(sc.request.route_segments.size(), 3u);
+  EXPECT_EQ(sc.request.route_segments[1].preferred_id, 122);
+  EXPECT_EQ(sc.request.route_segments[1].primitive_ids, (std::vector<std::int64_t>{112, 122}));
+  const std::string own_map = std::string(PULLOUT_SOURCE_DIR) + "/tests/maps/two_lane_road.osm";
+  auto p = problems_of(std::string(kPoses) + "map: " + own_map + "\nroute: [{preferred: 111}, {primitives: [112]}]\n");
+  EXPECT_TRUE(any_starts_with(p, "route[1].preferred: required")) << dump(p);
+  p = problems_of(std::string(kPoses) + "map: " + own_map + "\nroute: [{preferred: 111, primitives: [111, y]}]\n");
+  EXPECT_TRUE(any_starts_with(p, "route[0].primitives[1]: expected")) << dump(p);
+  p = problems_of(std::string(kPoses) + "map: " + own_map + "\nroute: [{preferred: 111, lanes: [1]}]\n");
+  EXPECT_TRUE(any_starts_with(p, "route[0].lanes: unknown key")) << dump(p);
+  p = problems_of(std::string(kPoses) + "map: " + own_map + "\nroute: [{preferred: 111}, 112]\n");
+  EXPECT_FALSE(p.empty());
+  p = problems_of(std::string(kPoses) + "map: " + own_map + "\nroute: [111, {preferred: 112}]\n");
+  EXPECT_TRUE(any_starts_with(p, "route[1]: expected a lanelet id")) << dump(p);
 }
 
 TEST(Scenario, PlannerSectionIsValidated) {

@@ -34,10 +34,14 @@ double push_end_to_low_curvature(const Polyline& center, double s0, double thres
   return best_s;
 }
 
-// Lateral offset l and its derivative dl/ds of the shifted path at centerline arc length s.
+// Lateral offset l and its derivative dl/ds of the shifted path at centerline arc length s, and
+// the share w (1 at the start, 0 at the shift end) of the start residual still applied, with dw/ds.
 struct Offset {
   double l{0.0};
   double dl{0.0};
+  double w{0.0};
+  double dw{0.0};
+  Vec2 residual{Vec2::Zero()};
 };
 
 class ShiftShape {
@@ -56,10 +60,16 @@ class ShiftShape {
     const auto st = profile_.at(time);
     const double p = st.position / total_;
     const double dp_du = st.velocity * profile_.total_time() / total_;
-    return {shift_length_ * (1.0 - p), -shift_length_ * dp_du / length_};
+    return {shift_length_ * (1.0 - p), -shift_length_ * dp_du / length_, 1.0 - p, -dp_du / length_, residual_};
   }
 
   double end() const { return s_begin_ + length_; }
+
+  // Where the start lies in the fan outside a corner of the centerline polyline, the point at
+  // lateral offset l from its projection misses it (by up to l (1 - cos) of the corner's angle):
+  // that residual is carried by the same profile, whole at the start and gone at the shift end,
+  // so that the path starts exactly at the vehicle.
+  void set_residual(const Vec2& r) { residual_ = r; }
 
  private:
   LateralJerkProfile profile_;
@@ -67,6 +77,7 @@ class ShiftShape {
   double shift_length_;
   double s_begin_;
   double length_;
+  Vec2 residual_{Vec2::Zero()};
 };
 
 Pose2 shifted_pose(const Polyline& center, double s, const Offset& o) {
@@ -74,9 +85,12 @@ Pose2 shifted_pose(const Polyline& center, double s, const Offset& o) {
   const Vec2 base = to_vec(c.pose);
   const double yaw_c = c.pose.yaw;
   const double k = c.curvature;
-  const Vec2 p = base + left_normal(heading(yaw_c)) * o.l;
-  // Tangent of base + n(s) l(s): t (1 - k l) + n l'.
-  return {p.x(), p.y(), normalize_angle(yaw_c + std::atan2(o.dl, 1.0 - k * o.l))};
+  const Vec2 t = heading(yaw_c);
+  const Vec2 n = left_normal(t);
+  const Vec2 p = base + n * o.l + o.residual * o.w;
+  // Tangent of base + n(s) l(s) + r w(s): t (1 - k l) + n l' + r w'.
+  const Vec2 tangent = t * (1.0 - k * o.l) + n * o.dl + o.residual * o.dw;
+  return {p.x(), p.y(), std::atan2(tangent.y(), tangent.x())};
 }
 
 // Path length of the shifted section over centerline length `length` from s_begin.
@@ -270,6 +284,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
         continue;
       }
       shape.emplace(k.profile, shift_length, s_start, s_end - s_start);
+      shape->set_residual(to_vec(start) - to_vec(shifted_pose(center, s_start, shape->at(s_start))));
     } else {
       shape.emplace(k.profile, 0.0, s_start, 0.0);
     }

@@ -98,7 +98,7 @@ std::vector<std::int64_t> kept_run(const std::vector<std::int64_t>& ids, const s
 RequestLanes request_lanes(const PullOutRequest& request, const LaneletMap* map, const VehicleInfo& vehicle,
                            const StartPlannerParameters& params, const RequestLimits& limits) {
   RequestLanes out;
-  const bool from_map = !request.route_lanelet_ids.empty() && map != nullptr;
+  const bool from_map = has_route(request) && map != nullptr;
   MapLanes selected;
   if (from_map) {
     MapLaneOptions options;
@@ -115,7 +115,8 @@ RequestLanes request_lanes(const PullOutRequest& request, const LaneletMap* map,
   const std::vector<Lane>& all = from_map ? selected.lanes : request.lanes;
   const double horizon = planning_horizon_m(params, vehicle);
   CroppedLanes cropped = crop_lanes(all, horizon_square(request.ego_pose.x, request.ego_pose.y, horizon));
-  const std::string field = from_map ? "route_lanelet_ids" : "lanes";
+  const std::string field =
+      from_map ? (request.route_segments.empty() ? "route_lanelet_ids" : "route_segments") : "lanes";
   const std::string where = " within the planning horizon (" + format_length(horizon) + " m around ego_pose)";
   const double kept_length = bounds_length(cropped.lanes);
   if (kept_length > limits.max_horizon_lane_length_m) {
@@ -278,7 +279,7 @@ double planning_horizon_m(const StartPlannerParameters& p, const VehicleInfo& ve
 std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) const {
   auto issues =
       validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
-  if (!issues.empty() || (request.lanes.empty() && request.route_lanelet_ids.empty())) return issues;
+  if (!issues.empty() || (request.lanes.empty() && !has_route(request))) return issues;
   const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_, limits_);
   if (!lanes.issues.empty()) return lanes.issues;
   const LaneWorld world(lanes.lanes);
@@ -363,7 +364,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     finish(result);
     return result;
   }
-  if (request.lanes.empty() && request.route_lanelet_ids.empty()) {  // validation allowed it: a grid and freespace
+  if (request.lanes.empty() && !has_route(request)) {  // validation allowed it: a grid and freespace
     result = plan_grid_only(request, stop);
     finish(result);
     return result;

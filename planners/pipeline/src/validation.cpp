@@ -163,12 +163,19 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
     c.add("deadline_ms", os.str());
   }
 
-  if (!r.route_lanelet_ids.empty()) {
+  if (has_route(r)) {
+    const std::string route_field = r.route_segments.empty() ? "route_lanelet_ids" : "route_segments";
     c.count("route_lanelet_ids", r.route_lanelet_ids.size(), limits.max_route_lanelets, "lanelets");
+    c.count("route_segments", r.route_segments.size(), limits.max_route_lanelets, "segments");
+    std::size_t primitives = 0;
+    for (const auto& segment : r.route_segments) primitives += segment.primitive_ids.size();
+    c.count("route_segments", primitives, limits.max_route_lanelets, "primitives in all segments");
     if (!has_map) {
-      c.add("route_lanelet_ids", "no Lanelet2 map is loaded by this planner: send inline lanes instead");
+      c.add(route_field, "no Lanelet2 map is loaded by this planner: send inline lanes instead");
     } else if (!r.lanes.empty()) {
-      c.add("lanes", "give either inline lanes or route_lanelet_ids on the map, not both");
+      c.add("lanes", "give either inline lanes or a route on the map, not both");
+    } else if (!r.route_lanelet_ids.empty() && !r.route_segments.empty()) {
+      c.add("route_segments", "give either route_lanelet_ids or route_segments, not both");
     }
   } else if (r.lanes.empty() && !(allow_grid_only && r.occupancy_grid)) {
     c.add("lanes", allow_grid_only ? "empty: send at least one lane of subtype road, or an occupancy grid"

@@ -193,6 +193,26 @@ Object read_object(const YAML::Node& node, const std::string& path, std::size_t 
   return object;
 }
 
+// {preferred: id, primitives: [id, ...]}: one segment of an Autoware route; primitives default to
+// [preferred].
+RouteSegment read_route_segment(const YAML::Node& node, const std::string& path, Problems& problems) {
+  RouteSegment out;
+  MapReader r(node, path, problems);
+  if (!r.valid()) return out;
+  if (!r.read("preferred", out.preferred_id) && !r.has("preferred")) {
+    problems.push_back(r.key_path("preferred") + ": required (the segment's preferred lanelet id)");
+  }
+  out.primitive_ids =
+      read_list<std::int64_t>(r, "primitives", [&](const YAML::Node& n, const std::string& p, std::size_t) {
+        return yaml_fields::to_int(n, p, problems).value_or(0);
+      });
+  if (r.has("primitives") && out.primitive_ids.empty()) {
+    problems.push_back(r.key_path("primitives") + ": must name at least one lanelet when given");
+  }
+  r.finish();
+  return out;
+}
+
 void read_expectation(MapReader& parent, ScenarioExpectation& out) {
   MapReader r(parent.get("expect"), "expect", parent.problems());
   if (!r.valid()) return;
@@ -257,12 +277,28 @@ Scenario load_scenario(const std::string& path, const Config& base) {
       problems.push_back(std::string("map: ") + e.what());
     }
   }
-  request.route_lanelet_ids =
-      read_list<std::int64_t>(root, "route", [&](const YAML::Node& n, const std::string& p, std::size_t) {
-        return yaml_fields::to_int(n, p, problems).value_or(0);
-      });
-  if (root.has("route") && request.route_lanelet_ids.empty())
-    problems.push_back("route: must name at least one lanelet");
+  // route: lanelet ids in driving order, or Autoware route segments ({preferred, primitives}); the
+  // first item decides which.
+  const YAML::Node route_node = root.has("route") ? root.get("route") : YAML::Node();
+  const bool by_segments = route_node.IsSequence() && route_node.size() > 0 && route_node[0].IsMap();
+  if (by_segments) {
+    request.route_segments = read_list<RouteSegment>(
+        root, "route",
+        [&](const YAML::Node& n, const std::string& p, std::size_t) { return read_route_segment(n, p, problems); });
+  } else {
+    request.route_lanelet_ids =
+        read_list<std::int64_t>(root, "route", [&](const YAML::Node& n, const std::string& p, std::size_t) {
+          if (n.IsMap()) {
+            problems.push_back(p +
+                               ": expected a lanelet id, like route[0] (or every item a segment {preferred, "
+                               "primitives})" +
+                               yaml_fields::where(n));
+            return std::int64_t{0};
+          }
+          return yaml_fields::to_int(n, p, problems).value_or(0);
+        });
+  }
+  if (root.has("route") && !has_route(request)) problems.push_back("route: must name at least one lanelet");
   if (root.has("map") && !root.has("route")) {
     problems.push_back("route: required with map: (the road lanelet ids to pull out onto, in driving order)");
   }

@@ -256,7 +256,10 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
     registry_.on_request(std::move(request), issues);
     return;
   }
-  if (request.route_lanelet_ids.empty()) {
+  if (!request.route_segments.empty()) {
+    spdlog::info("vehicle '{}' request {}: received (route of {} segments, {} objects)", request.vehicle_id,
+                 request.request_id, request.route_segments.size(), request.objects.size());
+  } else if (request.route_lanelet_ids.empty()) {
     spdlog::info("vehicle '{}' request {}: received ({} lanes, {} objects)", request.vehicle_id, request.request_id,
                  request.lanes.size(), request.objects.size());
   } else {

@@ -2,7 +2,9 @@
 //
 //   vehicle: {wheel_base: 2.79, ...}          # optional, overrides the config's vehicle
 //   map: ../maps/straight_shoulder.osm        # Lanelet2 map, relative to this file ...
-//   route: [101, 102, 103]                    # ... and the road lanelets to pull out onto, or:
+//   route: [101, 102, 103]                    # ... and the road lanelets to pull out onto, or
+//                                             # Autoware route segments: [{preferred: 101,
+//                                             #   primitives: [101, 111]}, ...]; or instead:
 //   lanes:                                    # inline lanes
 //     - {id: 1, subtype: road, speed_limit: 13.9,
 //        left_bound: [[0, 1.75], [100, 1.75]], right_bound: [[0, -1.75], [100, -1.75]],

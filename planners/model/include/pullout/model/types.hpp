@@ -106,6 +106,14 @@ struct PlannerOverrides {
   std::optional<SearchPolicy> search_policy;
 };
 
+// One segment of an Autoware route (autoware_planning_msgs LaneletSegment): the lanelet the route
+// prefers there and every lanelet of the segment (its lane-change neighbours, the preferred one
+// among them).
+struct RouteSegment {
+  std::int64_t preferred_id{0};
+  std::vector<std::int64_t> primitive_ids;
+};
+
 struct PullOutRequest {
   std::string vehicle_id;
   std::uint64_t request_id{0};
@@ -114,12 +122,16 @@ struct PullOutRequest {
   double ego_velocity_mps{0.0};
   Pose2 goal_pose;
   std::vector<Lane> lanes;                      // inline lanes, or ...
-  std::vector<std::int64_t> route_lanelet_ids;  // ... route lanelets on the service's map
+  std::vector<std::int64_t> route_lanelet_ids;  // ... route lanelets on the service's map, or ...
+  std::vector<RouteSegment> route_segments;     // ... an Autoware route (LaneletRoute's segments) on it
   std::vector<Object> objects;
   std::optional<OccupancyGrid> occupancy_grid;
   PlannerOverrides overrides;
   double deadline_ms{0.0};  // [ms] planning budget; 0 = the service's default
 };
+
+// Whether the request names a route on the map (ids or segments).
+inline bool has_route(const PullOutRequest& r) { return !r.route_lanelet_ids.empty() || !r.route_segments.empty(); }
 
 struct PathPoint {
   Pose2 pose;

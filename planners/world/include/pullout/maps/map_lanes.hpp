@@ -14,9 +14,19 @@
 //
 // Failure modes, as request issues naming the field (nothing else is set then):
 //   route_lanelet_ids[i]: an id not on the map, a lanelet that is not a road, a lanelet listed
-//     twice, a lanelet that does not follow the one before it (route not connected);
+//     twice, a lanelet that follows neither the one before it nor a lane-change neighbour of that
+//     one (route not connected);
+//   route_segments[i].preferred_primitive / .primitives[j] (an Autoware route, request.route_segments):
+//     the same per lanelet; a primitive that is no lane-change neighbour (through left / right
+//     neighbours) of the preferred lanelet; a preferred lanelet missing from non-empty primitives;
+//   route_segments[i]: no lanelet of the segment follows one of segment i-1 (route not connected);
 //   ego_pose: no road or road_shoulder lanelet within start_tolerance_m of the start;
-//   route_lanelet_ids: no route lanelet within max_route_distance_m of the start.
+//   route_lanelet_ids / route_segments: no route lanelet within max_route_distance_m of the start.
+//
+// Route segments: the road lanes start from the route lanelet nearest to the vehicle (any
+// primitive) and follow successors that are primitives of the next segments (the preferred
+// first); every primitive of a segment along the road lanes is handed to the core too, so that
+// paths may use the lane-change neighbours (as Autoware's lane departure check does).
 #pragma once
 
 #include <cstdint>
@@ -36,8 +46,9 @@ struct MapLaneOptions {
 
 struct MapLanes {
   std::vector<Lane> lanes;
-  std::vector<std::int64_t> road_ids;      // the road lanes, in driving order
-  std::vector<std::int64_t> pull_out_ids;  // the shoulder sequence, in driving order; empty: the road lanes
+  std::vector<std::int64_t> road_ids;       // the road lanes, in driving order
+  std::vector<std::int64_t> pull_out_ids;   // the shoulder sequence, in driving order; empty: the road lanes
+  std::vector<std::int64_t> neighbour_ids;  // lane-change neighbours from the route's segments along the road
   std::vector<RequestIssue> issues;
 };
 
