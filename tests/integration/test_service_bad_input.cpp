@@ -3,6 +3,7 @@
 // start-up with every problem named.
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <thread>
@@ -70,9 +71,10 @@ class RawRequestWriter {
 
   // Writes and waits until the service acknowledged it (the writer is volatile: it must stay
   // alive until then).
-  bool write(msg::PullOutRequest& sample) {
+  bool write(msg::PullOutRequest& sample, int ack_timeout_s = 10) {
     if (!writer_->write(&sample)) return false;
-    return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0)) == ReturnCode::RETCODE_OK;
+    return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(ack_timeout_s, 0)) ==
+           ReturnCode::RETCODE_OK;
   }
 
  private:
@@ -154,6 +156,62 @@ TEST_F(BadInput, MalformedRequestsAreRejectedNamingTheFieldWhileOthersAreServed)
   // After all that, both vehicles are served as usual.
   expect_served(*vehicle_b, vehicle_b->send(scenario.request));
   expect_served(*vehicle_a, vehicle_a->send(scenario.request));
+}
+
+// [bytes] Resident memory of a process (VmRSS of /proc/<pid>/status); 0 if unreadable.
+std::size_t resident_bytes(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stoul(line.substr(6)) * 1024;
+  }
+  return 0;
+}
+
+TEST_F(BadInput, ARequestOverTheReadersPayloadSizeIsDroppedBeforeItIsReceivedWhole) {
+  // The request reader's PREALLOCATED memory policy (config/dds/*.xml) fixes its payload size at
+  // the type's maximum serialized size (57,216,220 bytes): Fast DDS refuses a larger sample at its
+  // first fragment and acknowledges it as irrelevant, so the service never holds it. Before
+  // (PREALLOCATED_WITH_REALLOC) the reader grew a payload to the sample's size and took it whole.
+  start_service();
+  const Scenario scenario = load_test_scenario("straight_shoulder");
+  RawRequestWriter raw(domain());
+  ASSERT_TRUE(raw.wait_matched(std::chrono::duration_cast<std::chrono::milliseconds>(kMatchTimeout)));
+  const std::size_t rss_before = resident_bytes(service().pid());
+  ASSERT_GT(rss_before, 0U);
+
+  // About 100 MB of objects: 1,100 objects with 16 predicted paths of 100 poses each.
+  PullOutRequest big = scenario.request;
+  big.vehicle_id = "int-huge";
+  big.request_id = 7;
+  big.stamp_ns = system_now_ns();
+  msg::PullOutRequest sample = idl::to_msg(big);
+  msg::DetectedObject object;
+  object.id(1);
+  object.predicted_paths().resize(16);
+  for (auto& path : object.predicted_paths()) path.path().resize(100);
+  sample.objects().assign(1100, object);
+  const std::size_t bytes = msg::PullOutRequestPubSubType().getSerializedSizeProvider(&sample)();
+  ASSERT_GT(bytes, std::size_t{90} * 1000 * 1000);
+  // Acknowledged (as irrelevant) without being received: the writer does not wait for 100 MB.
+  ASSERT_TRUE(raw.write(sample, 60)) << "the oversized request was not acknowledged";
+
+  // The same writer's next request (of a normal size) is served: the big one holds nothing back.
+  auto huge = connect("int-huge");
+  ASSERT_NE(huge, nullptr);
+  PullOutRequest normal = big;
+  normal.request_id = 8;
+  normal.stamp_ns = system_now_ns();
+  msg::PullOutRequest normal_sample = idl::to_msg(normal);
+  ASSERT_TRUE(raw.write(normal_sample));
+  expect_served(*huge, normal.request_id);
+  // Another vehicle is served, and the service did not take the 100 MB in.
+  auto other = connect("int-after-huge");
+  ASSERT_NE(other, nullptr);
+  expect_served(*other, other->send(scenario.request));
+  const std::size_t rss_after = resident_bytes(service().pid());
+  EXPECT_LT(rss_after, rss_before + std::size_t{30} * 1024 * 1024)
+      << "service RSS grew from " << rss_before << " to " << rss_after << " bytes for a " << bytes << "-byte request";
 }
 
 TEST(ServiceStartup, RefusesABadConfigNamingEveryProblem) {

@@ -327,5 +327,85 @@ TEST(BoundedWork, MapCoordinatesBeyondTheLimitFailToLoadNamingTheNode) {
   }
 }
 
+// ---- the lane outline (fuzz/corpus/request/regress_lane_index_spike_timeout.cdr) ----
+
+// What fuzz_request found: the straight shoulder scenario whose road has a left bound of 2,000
+// points 5 cm apart, one of them moved 78.6 km out along the bound (a spike out and back). The
+// crop keeps the whole lane (its cross-sections meet the horizon at both ends), 157 km of bound.
+// The outline probes every 0.5 m of edge (1e5 probes per spike edge) against the lane pieces near
+// each probe; before, every probe was tested against the lane's own pieces stretched along the
+// spike (kept in the index's wide list, so near every probe) and two pieces holding 800 and 1,200
+// of the bound's vertices: 28.7 million point-edge tests for 302,826 probes (95 per probe), 4 s
+// under ASan, during validation, which ran without a deadline.
+std::vector<Lane> spiked_bound_lanes() {
+  std::vector<Lane> lanes = test::straight_shoulder_request().lanes;
+  Lane& road = lanes.front();
+  road.left_bound.clear();
+  for (int i = 0; i < 2000; ++i) road.left_bound.push_back(Point2{0.05 * i, 1.75});
+  road.left_bound[798].x = 78644.2;
+  return lanes;
+}
+
+TEST(LaneOutline, ASpikedBoundCostsAFewPointEdgeTestsPerProbe) {
+  const LaneWorld world(spiked_bound_lanes());
+  ASSERT_EQ(world.stopped(), StopReason::kNone);
+  // The probes: two 78.6 km edges at 1e5 pieces each (the cap per edge), and the rest.
+  ASSERT_GT(world.build_work(), 200000U);
+  // A probe along the spike meets no piece of another lane, one near the shoulder its 4-vertex
+  // piece: at most a few tests per probe (was 95).
+  EXPECT_LT(world.build_edge_tests(), 4 * world.build_work())
+      << world.build_edge_tests() << " point-edge tests for " << world.build_work() << " probes";
+  // Still the same outline: the road's edge shared with the shoulder (y = 1.75 for x in [0, 100])
+  // is not part of it, the road's right edge is.
+  EXPECT_TRUE(world.footprint_inside({Vec2{5, 1.0}, Vec2{9, 1.0}, Vec2{9, 2.5}, Vec2{5, 2.5}}));
+  EXPECT_FALSE(world.footprint_inside({Vec2{5, -2.5}, Vec2{9, -2.5}, Vec2{9, -1.0}, Vec2{5, -1.0}}));
+}
+
+TEST(LaneOutline, NoPieceHoldsMoreThan64VerticesOfABound) {
+  const Lane road = spiked_bound_lanes().front();
+  std::vector<Vec2> pts;
+  for (const Point2& p : road.left_bound) pts.push_back(to_vec(p));
+  const std::vector<Polygon> pieces =
+      cut_lane_into_pieces(Polyline(pts), Polyline({to_vec(road.right_bound[0]), to_vec(road.right_bound[1])}));
+  std::size_t vertices = 0;
+  for (const Polygon& piece : pieces) {
+    // Each piece: its left part (vertices strictly inside plus two cut points) and right part.
+    EXPECT_LE(piece.size(), 64U + 2U + 2U);
+    vertices += piece.size();
+  }
+  EXPECT_GE(vertices, 2000U);  // every vertex is in some piece
+
+  // Evenly spaced bounds are cut as before: one piece per 16 vertices, at equal arc lengths.
+  std::vector<Vec2> even_left;
+  std::vector<Vec2> even_right;
+  for (int i = 0; i < 160; ++i) {
+    even_left.emplace_back(i, 1.75);
+    even_right.emplace_back(i, -1.75);
+  }
+  EXPECT_EQ(cut_lane_into_pieces(Polyline(even_left), Polyline(even_right)).size(), 10U);
+}
+
+TEST(LaneOutline, ValidationAnswersWithoutBuildingTheWorld) {
+  // lanes_contain (validation, O(vertices)) gives LaneWorld::contains's answer.
+  std::vector<std::vector<Lane>> layouts = {spiked_bound_lanes(), test::straight_shoulder_request().lanes};
+  for (const auto& lanes : layouts) {
+    const LaneWorld world(lanes);
+    for (double x = -5.0; x <= 105.0; x += 1.37) {
+      for (double y = -6.0; y <= 6.0; y += 0.61) {
+        ASSERT_EQ(lanes_contain(lanes, {x, y}), world.contains({x, y})) << x << ", " << y;
+      }
+    }
+  }
+  PullOutRequest req = test::straight_shoulder_request();
+  req.lanes = spiked_bound_lanes();
+  EXPECT_TRUE(planner().validate(req).empty()) << format_issues(planner().validate(req));
+  req.ego_pose = {10.0, 30.0, 0.0};
+  const auto issues = planner().validate(req);
+  ASSERT_EQ(issues.size(), 1U);
+  EXPECT_EQ(issues.front().field, "ego_pose");
+  EXPECT_NE(issues.front().problem.find("is on no lane; the nearest, lane 2, is 25.25 m away"), std::string::npos)
+      << issues.front().problem;
+}
+
 }  // namespace
 }  // namespace pullout

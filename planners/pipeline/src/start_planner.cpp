@@ -173,14 +173,17 @@ std::string format_margin(double m) {
 }
 
 // The start pose must lie on a lane; a vehicle half a width outside still counts (it may stand
-// partly on the kerb), further away it is not on this request's lanes at all.
-std::optional<RequestIssue> check_start_on_lanes(const LaneWorld& world, const Pose2& ego, const VehicleInfo& v) {
+// partly on the kerb), further away it is not on this request's lanes at all. `inside`: whether the
+// lanes contain the ego position (LaneWorld::contains, or lanes_contain without a world).
+// O(vertices) beyond that.
+std::optional<RequestIssue> check_start_on_lanes(const std::vector<Lane>& lanes, bool inside, const Pose2& ego,
+                                                 const VehicleInfo& v) {
+  if (inside) return std::nullopt;
   const Vec2 p = to_vec(ego);
-  if (world.contains(p)) return std::nullopt;
   double nearest = std::numeric_limits<double>::infinity();
   std::int64_t nearest_id = 0;
-  for (const LaneGeometry& lane : world.lanes()) {
-    const Polygon& poly = lane.polygon;
+  for (const Lane& lane : lanes) {
+    const Polygon poly = bounds_polygon(lane);
     for (std::size_t i = 0; i < poly.size(); ++i) {
       const double d = distance_to_segment(p, poly[i], poly[(i + 1) % poly.size()]);
       if (d < nearest) {
@@ -282,8 +285,10 @@ std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) 
   if (!issues.empty() || (request.lanes.empty() && !has_route(request))) return issues;
   const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_, limits_);
   if (!lanes.issues.empty()) return lanes.issues;
-  const LaneWorld world(lanes.lanes);
-  if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) issues.push_back(*issue);
+  // No LaneWorld here: its index and outline cost far more than this one question, and
+  // validation runs without the request's deadline (VehicleSession::on_request). O(vertices).
+  const bool inside = lanes_contain(lanes.lanes, to_vec(request.ego_pose));
+  if (auto issue = check_start_on_lanes(lanes.lanes, inside, request.ego_pose, vehicle_)) issues.push_back(*issue);
   return issues;
 }
 
@@ -379,7 +384,8 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   planned_lanes = &lanes.lanes;
   const LaneWorld world(lanes.lanes, stop);
   if (world.stopped() != StopReason::kNone) return stopped_early(result, world.stopped());
-  if (auto issue = check_start_on_lanes(world, request.ego_pose, vehicle_)) {
+  if (auto issue =
+          check_start_on_lanes(lanes.lanes, world.contains(to_vec(request.ego_pose)), request.ego_pose, vehicle_)) {
     result.issues.push_back(*issue);
     result.outcome = PlanningResult::Outcome::kRejected;
     finish(result);

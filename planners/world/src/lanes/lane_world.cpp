@@ -31,7 +31,11 @@ std::vector<Vec2> to_vecs(const std::vector<Point2>& pts) {
   return out;
 }
 
-constexpr std::size_t kPieceVertices = 16;  // bound vertices per lane piece (each side)
+constexpr std::size_t kPieceVertices = 16;  // bound vertices per lane piece (each side), on average
+// At most this many bound vertices strictly inside one piece, on either side: a piece that would
+// hold more (the bound's vertices crowd into a short stretch of its arc length, next to a long
+// edge) is cut again at its vertices, so that one point test costs at most this many edges per side.
+constexpr std::size_t kMaxPieceVertices = 64;
 
 // Appends the vertices of `line` strictly between arc lengths s0 and s1, in order, starting the
 // scan at `next` (the first vertex not yet passed) and leaving it at the first vertex at or beyond
@@ -42,16 +46,79 @@ void append_between(const Polyline& line, double s0, double s1, std::size_t& nex
   while (next < line.size() && line.s(next) < s1 - 1e-9) out.push_back(line.point(next++));
 }
 
-// The lane polygon cut into pieces at common normalised arc lengths of both bounds.
-std::vector<Polygon> cut_into_pieces(const Polyline& left, const Polyline& right) {
+// The vertices of `line` strictly between normalised arc lengths t0 and t1 (as append_between
+// picks them): [first, last) indices.
+std::pair<std::size_t, std::size_t> vertices_between(const Polyline& line, double t0, double t1) {
+  const double s0 = t0 * line.length() + 1e-9;
+  const double s1 = t1 * line.length() - 1e-9;
+  std::size_t first = 0;
+  std::size_t last = line.size();
+  {  // first vertex with s > s0
+    std::size_t lo = 0;
+    std::size_t hi = line.size();
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (line.s(mid) <= s0)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    first = lo;
+  }
+  {  // first vertex with s >= s1
+    std::size_t lo = first;
+    std::size_t hi = line.size();
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (line.s(mid) < s1)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    last = lo;
+  }
+  return {first, std::max(first, last)};
+}
+
+// Appends to `cuts` the normalised arc lengths in (t0, t1) at which [t0, t1] must be cut again so
+// that no part holds more than kMaxPieceVertices vertices of either bound: the middle vertex of the
+// crowded side, recursively (each cut halves that side's count).
+void refine_cuts(const Polyline& left, const Polyline& right, double t0, double t1, std::vector<double>& cuts,
+                 int depth = 0) {
+  const auto [l0, l1] = vertices_between(left, t0, t1);
+  const auto [r0, r1] = vertices_between(right, t0, t1);
+  const std::size_t nl = l1 - l0;
+  const std::size_t nr = r1 - r0;
+  if ((nl <= kMaxPieceVertices && nr <= kMaxPieceVertices) || depth > 64) return;
+  const bool on_left = nl >= nr;
+  const Polyline& line = on_left ? left : right;
+  const std::size_t mid = on_left ? l0 + nl / 2 : r0 + nr / 2;
+  const double t = line.s(mid) / line.length();
+  if (!(t > t0 && t < t1)) return;  // rounding: nothing to gain
+  refine_cuts(left, right, t0, t, cuts, depth + 1);
+  cuts.push_back(t);
+  refine_cuts(left, right, t, t1, cuts, depth + 1);
+}
+
+}  // namespace
+
+std::vector<Polygon> cut_lane_into_pieces(const Polyline& left, const Polyline& right) {
   const std::size_t n = std::max<std::size_t>(1, std::max(left.size(), right.size()) / kPieceVertices);
-  std::vector<Polygon> pieces;
-  pieces.reserve(n);
-  std::size_t next_left = 0;
-  std::size_t next_right = 0;
+  // The cuts: n pieces of equal normalised arc length, each cut again where its vertices crowd.
+  std::vector<double> cuts{0.0};
   for (std::size_t k = 0; k < n; ++k) {
     const double t0 = static_cast<double>(k) / static_cast<double>(n);
     const double t1 = static_cast<double>(k + 1) / static_cast<double>(n);
+    refine_cuts(left, right, t0, t1, cuts);
+    cuts.push_back(t1);
+  }
+  std::vector<Polygon> pieces;
+  pieces.reserve(cuts.size() - 1);
+  std::size_t next_left = 0;
+  std::size_t next_right = 0;
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double t0 = cuts[k];
+    const double t1 = cuts[k + 1];
     Polygon piece{left.point_at(t0 * left.length())};
     append_between(left, t0 * left.length(), t1 * left.length(), next_left, piece);
     piece.push_back(left.point_at(t1 * left.length()));
@@ -64,8 +131,14 @@ std::vector<Polygon> cut_into_pieces(const Polyline& left, const Polyline& right
   return pieces;
 }
 
+namespace {
+
 // Work items (centerline samples, edge pieces) between two checks of the stop condition.
 constexpr std::size_t kStopCheckInterval = 1024;
+// Point-edge tests (vertices of the lane pieces tested) between two checks, at most.
+constexpr std::size_t kEdgeTestsPerCheck = std::size_t{1} << 16;
+// A piece whose box covers more cells of the fine index than this goes to the coarse one.
+constexpr double kMaxCellsPerPiece = 4096;
 
 // Midline of two bounds, matched by normalised arc length. Empty when `stop` says stop first.
 Polyline derive_centerline(const Polyline& left, const Polyline& right, const StopCondition& stop,
@@ -83,6 +156,24 @@ Polyline derive_centerline(const Polyline& left, const Polyline& right, const St
 }
 
 }  // namespace
+
+Polygon bounds_polygon(const Lane& lane) {
+  Polygon polygon = Polyline(to_vecs(lane.left_bound)).points();
+  const Polyline right(to_vecs(lane.right_bound));
+  polygon.insert(polygon.end(), right.points().rbegin(), right.points().rend());
+  return polygon;
+}
+
+bool lanes_contain(const std::vector<Lane>& lanes, const Vec2& p) {
+  for (const Lane& lane : lanes) {
+    const Polyline left(to_vecs(lane.left_bound));
+    const Polyline right(to_vecs(lane.right_bound));
+    for (const Polygon& piece : cut_lane_into_pieces(left, right)) {
+      if (bounding_box(piece).contains(p) && point_in_polygon(piece, p)) return true;
+    }
+  }
+  return false;
+}
 
 std::size_t LaneChain::lane_at(double s) const {
   const auto it = std::lower_bound(lane_end_s.begin(), lane_end_s.end(), s);
@@ -105,7 +196,7 @@ LaneWorld::LaneWorld(const std::vector<Lane>& lanes, const StopCondition& stop) 
     g.polygon = g.left.points();
     g.polygon.insert(g.polygon.end(), g.right.points().rbegin(), g.right.points().rend());
     g.box = bounding_box(g.polygon);
-    g.pieces = cut_into_pieces(g.left, g.right);
+    g.pieces = cut_lane_into_pieces(g.left, g.right);
     for (const Polygon& piece : g.pieces) g.piece_boxes.push_back(bounding_box(piece));
     g.speed_limit_mps = in.speed_limit_mps;
     work_ += g.centerline.size();
@@ -140,12 +231,21 @@ void LaneWorld::build_topology() {
 void LaneWorld::build_index(const StopCondition& stop) {
   for (std::size_t i = 0; i < lanes_.size(); ++i) {
     for (std::size_t k = 0; k < lanes_[i].pieces.size(); ++k) {
-      piece_index_.insert(lanes_[i].piece_boxes[k], {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
+      const Aabb& box = lanes_[i].piece_boxes[k];
+      const std::pair<std::uint32_t, std::uint32_t> value{static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)};
+      if (piece_index_.cell_count(box) > kMaxCellsPerPiece) {
+        coarse_piece_index_.insert(box, value);
+      } else {
+        piece_index_.insert(box, value);
+      }
     }
   }
   // An edge piece belongs to the outline of the union unless the point just outside it lies in
   // another lane (a shared bound, or the joint between consecutive lanes). Pieces are short so
   // that bounds sampled differently on the two sides are still recognised as shared.
+  // The stop condition is checked every kStopCheckInterval edge pieces and every
+  // kEdgeTestsPerCheck point-edge tests, whichever comes first.
+  std::size_t next_check = kEdgeTestsPerCheck;
   for (std::size_t i = 0; i < lanes_.size(); ++i) {
     const Polygon& poly = lanes_[i].polygon;
     const double orientation = signed_area(poly) >= 0.0 ? 1.0 : -1.0;
@@ -163,11 +263,16 @@ void LaneWorld::build_index(const StopCondition& stop) {
       // departure test sees few long segments.
       std::optional<Vec2> run_start;
       for (std::size_t p = 0; p < pieces; ++p) {
-        if (++work_ % kStopCheckInterval == 0 && (stopped_ = stop.check()) != StopReason::kNone) return;
+        if ((++work_ % kStopCheckInterval == 0 || edge_tests_ >= next_check) &&
+            (stopped_ = stop.check()) != StopReason::kNone) {
+          return;
+        }
+        if (edge_tests_ >= next_check) next_check = edge_tests_ + kEdgeTestsPerCheck;
         const Vec2 pa = a + dir * (len * static_cast<double>(p) / static_cast<double>(pieces));
         const Vec2 pb = a + dir * (len * static_cast<double>(p + 1) / static_cast<double>(pieces));
         const Vec2 probe = 0.5 * (pa + pb) + kSharedEdgeProbe * outward;
-        const bool shared = inside_other_lane(probe, i);
+        const bool shared = any_piece_containing(
+            probe, i, [](std::size_t) { return true; }, &edge_tests_);
         if (!shared && !run_start) run_start = pa;
         if (shared && run_start) {
           outer_edges_.emplace_back(*run_start, pa);
@@ -186,18 +291,21 @@ void LaneWorld::build_index(const StopCondition& stop) {
 }
 
 template <typename F>
-bool LaneWorld::any_piece_containing(const Vec2& p, F&& accept) const {
-  const auto test = [&](std::uint32_t lane, std::uint32_t piece) {
-    const LaneGeometry& g = lanes_[lane];
-    return g.piece_boxes[piece].contains(p) && point_in_polygon(g.pieces[piece], p) && accept(lane);
+bool LaneWorld::any_piece_containing(const Vec2& p, std::size_t skip_lane, F&& accept, std::size_t* edge_tests) const {
+  const auto test = [&](const std::pair<std::uint32_t, std::uint32_t>& v) {
+    if (v.first == skip_lane) return false;  // before the polygon test: the lane's own pieces cost nothing
+    const LaneGeometry& g = lanes_[v.first];
+    if (!g.piece_boxes[v.second].contains(p)) return false;
+    const Polygon& piece = g.pieces[v.second];
+    if (edge_tests != nullptr) *edge_tests += piece.size();
+    return point_in_polygon(piece, p) && accept(v.first);
   };
-  return piece_index_.any_at(p,
-                             [&](const std::pair<std::uint32_t, std::uint32_t>& v) { return test(v.first, v.second); });
+  return piece_index_.any_at(p, test) || coarse_piece_index_.any_at(p, test);
 }
 
 std::vector<std::size_t> LaneWorld::lanes_containing(const Vec2& p) const {
   std::vector<std::size_t> out;
-  any_piece_containing(p, [&out](std::size_t lane) {
+  any_piece_containing(p, kNoLane, [&out](std::size_t lane) {
     // A point on the cut between two pieces may be reported by both.
     if (std::find(out.begin(), out.end(), lane) == out.end()) out.push_back(lane);
     return false;  // keep looking: the point may lie in several lanes
@@ -205,12 +313,8 @@ std::vector<std::size_t> LaneWorld::lanes_containing(const Vec2& p) const {
   return out;
 }
 
-bool LaneWorld::inside_other_lane(const Vec2& p, std::size_t lane) const {
-  return any_piece_containing(p, [lane](std::size_t other) { return other != lane; });
-}
-
 bool LaneWorld::contains(const Vec2& p) const {
-  return any_piece_containing(p, [](std::size_t) { return true; });
+  return any_piece_containing(p, kNoLane, [](std::size_t) { return true; });
 }
 
 std::optional<std::size_t> LaneWorld::nearest_lane(const Vec2& p, LaneSubtype subtype) const {

@@ -53,6 +53,18 @@ struct LaneChain {
   std::size_t lane_at(double s) const;
 };
 
+// The lane polygon (left bound forward, right bound backward) cut across the lane into pieces at
+// common normalised arc lengths of both bounds: about one piece per 16 vertices of the longer
+// bound, each cut again where more than 64 vertices of one bound crowd into it, so that a point
+// test against one piece costs at most about 130 edges. O(vertices + pieces x log vertices).
+std::vector<Polygon> cut_lane_into_pieces(const Polyline& left, const Polyline& right);
+
+// The polygon of a lane as LaneGeometry::polygon has it.
+Polygon bounds_polygon(const Lane& lane);
+// Whether p lies in one of the lanes: the same answer as LaneWorld(lanes).contains(p), without
+// building the world (no index, no outline). O(vertices): for one query, e.g. validation.
+bool lanes_contain(const std::vector<Lane>& lanes, const Vec2& p);
+
 class LaneWorld {
  public:
   explicit LaneWorld(const std::vector<Lane>& lanes, const StopCondition& stop = {});
@@ -62,6 +74,9 @@ class LaneWorld {
   // Units of work the build did: centerline points and edge pieces examined. A measure of its
   // memory and time that does not depend on the clock (for tests and benchmarks).
   std::size_t build_work() const { return work_; }
+  // Point-edge tests the build made to find the outline of the union (each edge piece's probe
+  // against the candidate lane pieces near it): the build's other measure of time.
+  std::size_t build_edge_tests() const { return edge_tests_; }
 
   const std::vector<LaneGeometry>& lanes() const { return lanes_; }
   std::optional<std::size_t> find(std::int64_t id) const;
@@ -90,18 +105,27 @@ class LaneWorld {
  private:
   void build_topology();
   void build_index(const StopCondition& stop);
-  bool inside_other_lane(const Vec2& p, std::size_t lane) const;
 
   std::vector<LaneGeometry> lanes_;
   StopReason stopped_{StopReason::kNone};
   std::size_t work_{0};
+  std::size_t edge_tests_{0};
   // Pieces of lane edges that are not shared with a neighbouring lane: the outline of the union.
   std::vector<std::pair<Vec2, Vec2>> outer_edges_;
   static constexpr double kCellSize = 4.0;  // [m] cells of the indexes
-  // (lane index, piece index) of the lane pieces, by the cells their boxes cover.
+  // Cells of the coarse piece index: 64 fine cells a side.
+  static constexpr double kCoarseCellSize = 64 * kCellSize;
+  static constexpr std::size_t kNoLane = static_cast<std::size_t>(-1);
+  // (lane index, piece index) of the lane pieces, by the cells their boxes cover: the fine index
+  // holds pieces covering up to 4096 of its cells, the coarse one the larger pieces (a diagonal
+  // lane of a few hundred metres, a bound with a long spike), so that a query meets the large
+  // pieces near it rather than every large piece of the world.
   GridIndex<std::pair<std::uint32_t, std::uint32_t>> piece_index_{kCellSize};
+  GridIndex<std::pair<std::uint32_t, std::uint32_t>> coarse_piece_index_{kCoarseCellSize};
+  // Calls accept(lane) for the lanes other than skip_lane with a piece containing p until it
+  // returns true; counts the point-edge tests in *edge_tests when given.
   template <typename F>
-  bool any_piece_containing(const Vec2& p, F&& accept) const;
+  bool any_piece_containing(const Vec2& p, std::size_t skip_lane, F&& accept, std::size_t* edge_tests = nullptr) const;
   // Indices into outer_edges_, by the cells their boxes cover.
   GridIndex<std::uint32_t> edge_index_{kCellSize};
 };
