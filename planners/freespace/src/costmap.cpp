@@ -261,10 +261,6 @@ bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& st
         for (int i = i0; i <= i1; ++i) visit(i, j);
       }
     };
-    if (hard_.empty()) {  // no exact layer (a grid rasterised for export): occupancy only
-      cells_of(g.data(), g.size(), [&](int i, int j) { occupied_[index(i, j)] = 1; });
-      continue;
-    }
     // The exact layer: the cells an edge meets are partial, the others hard when their centre lies
     // inside the polygon (the row extents of a non-convex polygon also cover its concavities:
     // those cells are partial, the exact test finds them free).
@@ -284,15 +280,22 @@ bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& st
     const bool lane_edge = static_cast<std::size_t>(&poly - polygons.data()) < lane_edges;
     cells_of(g.data(), g.size(), [&](int i, int j) {
       const std::size_t c = index(i, j);
-      occupied_[c] = 1;
-      if (lane_edge) hard_[c] = 0;
-      if (hard_[c] != 0) return;
-      const bool on_edge = std::binary_search(edge_cells.begin(), edge_cells.end(), static_cast<std::uint32_t>(c));
-      if (!on_edge && closed && grid_point_in_polygon(g, {i + 0.5, j + 0.5})) {
-        hard_[c] = 1;
-      } else {
+      if (lane_edge) {
+        occupied_[c] = 1;
+        hard_[c] = 0;
         partial_.emplace_back(static_cast<std::uint32_t>(c), shape);
+        return;
       }
+      if (!std::binary_search(edge_cells.begin(), edge_cells.end(), static_cast<std::uint32_t>(c))) {
+        // No edge meets the cell's interior: it lies inside the polygon entirely (hard) or
+        // outside entirely (a concavity: left as it is).
+        if (!closed || !grid_point_in_polygon(g, {i + 0.5, j + 0.5})) return;
+        occupied_[c] = 1;
+        hard_[c] = 1;
+        return;
+      }
+      occupied_[c] = 1;
+      if (hard_[c] == 0) partial_.emplace_back(static_cast<std::uint32_t>(c), shape);
     });
   }
   return true;

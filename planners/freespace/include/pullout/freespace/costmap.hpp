@@ -58,9 +58,9 @@ class Costmap {
                                const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
                                const std::vector<Polygon>& obstacles, const StopCondition& stop = {});
 
-  // Marks every cell whose interior a polygon (map frame) meets as occupied (conservative;
-  // non-convex polygons are filled row by row between their extreme points; a segment marks the
-  // cells it passes through). Updates the precomputation.
+  // Marks every cell whose interior a polygon (map frame) meets as occupied (a segment marks the
+  // cells it passes through; a cell in a non-convex polygon's concavity that no edge meets stays
+  // as it was). The polygons join the exact layer. Updates the precomputation.
   void add_obstacles(const std::vector<Polygon>& polygons, const StopCondition& stop = {});
 
   // A polygon or lane edge kept for the exact test, grid frame in cell units. `closed`: a polygon
