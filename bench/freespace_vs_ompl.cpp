@@ -2,7 +2,8 @@
 // same run, with the same collision test and the same time budget.
 //
 //   build/bench/bench_freespace [--problems 24] [--budget-ms 2000] [--seed 5] [--heuristic-weight 2.0]
-//                               [--theta-size N] [--xy-resolution M] [--narrow-penalty P] [--ours-only]
+//                               [--theta-size N] [--xy-resolution M] [--narrow-penalty P] [--turning-steps S]
+//                               [--ours-only]
 //
 //   build/bench/bench_freespace --tpcap ../shared/benchmarks/tpcap [--resolution 0.1] [--budget-ms 10000]
 //
@@ -165,6 +166,7 @@ struct SearchOverrides {
   int theta_size{0};
   double xy_resolution{0.0};
   double narrow_penalty{-1.0};  // < 0: the default
+  int turning_steps{0};
 } g_search;
 
 struct Run {
@@ -181,6 +183,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   pullout::HybridAStarConfig config;
   config.theta_size = g_search.theta_size > 0 ? g_search.theta_size : config.theta_size;
   config.xy_resolution = g_search.xy_resolution;
+  if (g_search.turning_steps > 0) config.turning_steps = g_search.turning_steps;
   if (g_search.narrow_penalty >= 0.0) config.narrow_heuristic_penalty = g_search.narrow_penalty;
   std::vector<Pose2> expanded;
   const char* dump = std::getenv("PULLOUT_DUMP_EXPANSIONS");  // directory: <problem index>.pgm / .txt
@@ -350,6 +353,8 @@ int main(int argc, char** argv) {
       g_search.theta_size = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--xy-resolution") == 0) {
       g_search.xy_resolution = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--turning-steps") == 0) {
+      g_search.turning_steps = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--narrow-penalty") == 0) {
       g_search.narrow_penalty = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--heuristic-weight") == 0) {
