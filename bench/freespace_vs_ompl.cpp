@@ -2,8 +2,15 @@
 // same run, with the same collision test and the same time budget.
 //
 //   build/bench/bench_freespace [--problems 24] [--budget-ms 2000] [--seed 5] [--heuristic-weight 2.0]
-//                               [--theta-size N] [--xy-resolution M] [--narrow-penalty P] [--ours-only]
+//                               [--theta-size N] [--xy-resolution M] [--narrow-penalty P] [--turning-steps S]
+//                               [--ours-only]
 //
+//   build/bench/bench_freespace --tpcap ../shared/benchmarks/tpcap [--resolution 0.1] [--budget-ms 10000]
+//
+// --tpcap runs the 20 TPCAP cases (bench/tpcap.hpp; read at run time, never committed) instead of
+// the generated lots: the organisers' vehicle (no shape margin), turning radius from wheelbase
+// 2.8 m and steering 0.75 rad, the map the organisers' demo draws (start and goal box +-15 m),
+// the obstacle polygons exact (Costmap::from_polygons).
 // --ours-only skips OMPL and prints the expansions of each search. With the environment variable
 // PULLOUT_DUMP_EXPANSIONS=<dir>, each problem's costmap (<i>.pgm) and the poses our search expanded
 // (<i>.txt: "E x y yaw" lines) are written there, to see where a search spends its time.
@@ -47,6 +54,7 @@
 #include "pullout/freespace/reeds_shepp.hpp"
 #include "pullout/geometry/angle.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
+#include "tpcap.hpp"
 
 namespace {
 
@@ -158,6 +166,7 @@ struct SearchOverrides {
   int theta_size{0};
   double xy_resolution{0.0};
   double narrow_penalty{-1.0};  // < 0: the default
+  int turning_steps{0};
 } g_search;
 
 struct Run {
@@ -166,6 +175,7 @@ struct Run {
   double length{0.0};
   int direction_changes{0};
   std::size_t expansions{0};
+  int status{0};  // ours: HybridAStarResult::Status
 };
 
 Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
@@ -173,6 +183,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   pullout::HybridAStarConfig config;
   config.theta_size = g_search.theta_size > 0 ? g_search.theta_size : config.theta_size;
   config.xy_resolution = g_search.xy_resolution;
+  if (g_search.turning_steps > 0) config.turning_steps = g_search.turning_steps;
   if (g_search.narrow_penalty >= 0.0) config.narrow_heuristic_penalty = g_search.narrow_penalty;
   std::vector<Pose2> expanded;
   const char* dump = std::getenv("PULLOUT_DUMP_EXPANSIONS");  // directory: <problem index>.pgm / .txt
@@ -187,6 +198,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   run.success = r.status == pullout::HybridAStarResult::Status::kSuccess;
   run.length = r.length;
   run.expansions = r.expansions;
+  run.status = static_cast<int>(r.status);
   if (dump != nullptr) {
     // A picture of the search: the costmap as a PGM (north up) and the expanded poses as text.
     static int index = 0;
@@ -273,6 +285,34 @@ Run run_ompl(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   return run;
 }
 
+// TPCAP case `number` (1-based) as a Problem: grid origin at the map box's min corner.
+bool make_tpcap(const std::string& dir, int number, double resolution, Problem& out) {
+  pullout::bench::TpcapCase c;
+  std::string error;
+  if (!pullout::bench::load_tpcap(dir + "/Case" + std::to_string(number) + ".csv", c, error)) {
+    std::fprintf(stderr, "%s\n", error.c_str());
+    return false;
+  }
+  constexpr double kBox = 15.0;  // [m] the organisers' demo map around start and goal
+  const pullout::Vec2 lo(std::min(c.start.x, c.goal.x) - kBox, std::min(c.start.y, c.goal.y) - kBox);
+  const pullout::Vec2 hi(std::max(c.start.x, c.goal.x) + kBox, std::max(c.start.y, c.goal.y) + kBox);
+  pullout::Aabb extent;
+  extent.extend({0.0, 0.0});
+  extent.extend(hi - lo);
+  for (auto& poly : c.obstacles) {
+    for (auto& v : poly) v -= lo;
+  }
+  const pullout::Polygon all{
+      {0.0, 0.0}, {hi.x() - lo.x(), 0.0}, {hi.x() - lo.x(), hi.y() - lo.y()}, {0.0, hi.y() - lo.y()}};
+  out.name = "tpcap " + std::to_string(number);
+  out.size = std::max(hi.x() - lo.x(), hi.y() - lo.y());
+  out.resolution = resolution;
+  out.costmap = pullout::Costmap::from_polygons(extent, resolution, {all}, {}, c.obstacles);
+  out.start = {c.start.x - lo.x(), c.start.y - lo.y(), c.start.yaw};
+  out.goal = {c.goal.x - lo.x(), c.goal.y - lo.y(), c.goal.yaw};
+  return true;
+}
+
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());
@@ -293,10 +333,16 @@ int main(int argc, char** argv) {
   unsigned seed = 5;
   double heuristic_weight = 2.0;  // astar.distance_heuristic_weight (its default)
   bool ours_only = false;         // --ours-only: skip OMPL, print search statistics
+  std::string tpcap;              // --tpcap DIR: the TPCAP cases instead of generated lots
+  double tpcap_resolution = 0.1;  // [m]
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(argv[i], "--ours-only") == 0) {
       ours_only = true;
+    } else if (has_value && std::strcmp(argv[i], "--tpcap") == 0) {
+      tpcap = argv[++i];
+    } else if (has_value && std::strcmp(argv[i], "--resolution") == 0) {
+      tpcap_resolution = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--problems") == 0) {
       problems = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--budget-ms") == 0) {
@@ -307,6 +353,8 @@ int main(int argc, char** argv) {
       g_search.theta_size = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--xy-resolution") == 0) {
       g_search.xy_resolution = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--turning-steps") == 0) {
+      g_search.turning_steps = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--narrow-penalty") == 0) {
       g_search.narrow_penalty = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--heuristic-weight") == 0) {
@@ -319,17 +367,33 @@ int main(int argc, char** argv) {
   ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
   ompl::RNG::setSeed(seed);  // before any OMPL sampler exists: the peers' runs are reproducible too
   const pullout::VehicleInfo vehicle;
-  const double radius = vehicle.wheel_base_m / std::tan(vehicle.max_steer_angle_rad * 0.7);  // max_turning_ratio 0.7
-  const pullout::Footprint fp = pullout::vehicle_footprint(vehicle, kMargin);
+  double radius = vehicle.wheel_base_m / std::tan(vehicle.max_steer_angle_rad * 0.7);  // max_turning_ratio 0.7
+  pullout::Footprint fp = pullout::vehicle_footprint(vehicle, kMargin);
+  if (!tpcap.empty()) {
+    problems = 20;
+    radius = pullout::bench::kTpcapWheelbase / std::tan(pullout::bench::kTpcapMaxSteer);
+    fp = {pullout::bench::kTpcapFront, pullout::bench::kTpcapRear, pullout::bench::kTpcapHalfWidth,
+          pullout::bench::kTpcapHalfWidth};
+  }
   std::mt19937 rng(seed);
   const char* names[3] = {"hybrid A* (pullout)", "OMPL RRT*", "OMPL BIT*"};
   std::vector<Run> runs[3];
   std::vector<double> small_ours;  // 30 m at 0.2 m
   std::printf("%-18s %28s %28s %28s\n", "problem", names[0], names[1], names[2]);
   for (int i = 0; i < problems; ++i) {
-    const Problem p = make_problem(i, rng, fp);
+    Problem p;
+    if (tpcap.empty()) {
+      p = make_problem(i, rng, fp);
+    } else if (!make_tpcap(tpcap, i + 1, tpcap_resolution, p)) {
+      return 1;
+    }
     const pullout::GridCollisionChecker checker(p.costmap, fp);
     if (checker.collides(p.start) || checker.collides(p.goal)) {
+      if (!tpcap.empty()) {
+        std::printf("%-18s start or goal in collision\n", p.name.c_str());
+        for (auto& r : runs) r.push_back({});
+        continue;
+      }
       std::printf("%-18s invalid start or goal (generator bug)\n", p.name.c_str());
       return 1;
     }
@@ -338,6 +402,7 @@ int main(int argc, char** argv) {
       runs[0].push_back(r);
       std::printf("%-18s %8.1f ms %6.1f m %2d cusps %8zu expansions%s\n", p.name.c_str(), r.time_ms, r.length,
                   r.direction_changes, r.expansions, r.success ? "" : "  (no solution)");
+      if (!r.success) std::printf("%-18s   status %d (HybridAStarResult::Status)\n", "", r.status);
       if (p.size == 30.0 && p.resolution > 0.15 && r.success) small_ours.push_back(r.time_ms);
       continue;
     }

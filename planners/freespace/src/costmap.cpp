@@ -1,6 +1,7 @@
 #include "pullout/freespace/costmap.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -165,21 +166,66 @@ Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std:
     }
   }
   Costmap map(origin, resolution, w, h, std::move(occ), kDeferred);
-  // The outline cuts through the cells it touches: those are not entirely drivable.
+  // Cells with their centre outside the lanes and crossed by no outline edge lie entirely outside:
+  // hard. The outline cuts through the cells it touches: those are partial (the edge decides).
+  map.ensure_hard();
+  for (const Polygon& poly : drivable) {
+    std::vector<Vec2> g;
+    g.reserve(poly.size());
+    for (const Vec2& p : poly) g.push_back(map.to_grid(p));
+    map.drivable_.push_back(std::move(g));
+  }
   std::vector<Polygon> blocked;
   blocked.reserve(drivable_outline.size() + obstacles.size());
   for (const auto& [a, b] : drivable_outline) blocked.push_back({a, b});
   blocked.insert(blocked.end(), obstacles.begin(), obstacles.end());
-  if (map.mark(blocked, stop)) map.precompute(stop);
+  if (map.mark(blocked, stop, drivable_outline.size())) map.precompute(stop);
   return map;
 }
 
 void Costmap::add_obstacles(const std::vector<Polygon>& polygons, const StopCondition& stop) {
+  ensure_hard();
   if (mark(polygons, stop)) precompute(stop);
 }
 
-bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& stop) {
+void Costmap::ensure_hard() {
+  if (hard_.size() != occupied_.size()) hard_ = occupied_;
+}
+
+namespace {
+
+// Even-odd point in polygon (grid frame).
+bool grid_point_in_polygon(const std::vector<Vec2>& poly, const Vec2& p) {
+  bool in = false;
+  const std::size_t n = poly.size();
+  for (std::size_t i = 0, k = n - 1; i < n; k = i++) {
+    const Vec2& a = poly[i];
+    const Vec2& b = poly[k];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x())) {
+      in = !in;
+    }
+  }
+  return in;
+}
+
+}  // namespace
+
+void Costmap::partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) const {
+  const auto cell = static_cast<std::uint32_t>(index(ix, iy));
+  auto it = std::lower_bound(partial_.begin(), partial_.end(), std::make_pair(cell, std::uint32_t{0}));
+  for (; it != partial_.end() && it->first == cell; ++it) out.push_back(it->second);
+}
+
+bool Costmap::inside_drivable(const Vec2& p_G) const {
+  if (drivable_.empty()) return true;
+  return std::any_of(drivable_.begin(), drivable_.end(), [&](const std::vector<Vec2>& poly) {
+    return poly.size() >= 3 && grid_point_in_polygon(poly, p_G);
+  });
+}
+
+bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& stop, std::size_t lane_edges) {
   std::vector<Vec2> g;
+  std::vector<std::uint32_t> edge_cells;
   std::size_t count = 0;
   for (const Polygon& poly : polygons) {
     if (poly.empty()) continue;
@@ -195,16 +241,62 @@ bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& st
     // A cell is marked when the polygon meets its interior: a polygon that ends exactly on a
     // cell boundary (a wall 0.4 m thick on 0.2 m cells) does not mark the next cell.
     constexpr double kInterior = 1e-9;  // [cells]
-    const int j0 = clamped_int(std::floor(y_lo + kInterior), 0, height_);
-    const int j1 = clamped_int(std::floor(y_hi - kInterior), -1, height_ - 1);
-    for (int j = j0; j <= j1; ++j) {
-      double x0 = 0.0;
-      double x1 = 0.0;
-      if (!strip_extent(g.data(), g.size(), j + kInterior, j + 1.0 - kInterior, x0, x1)) continue;
-      const int i0 = clamped_int(std::floor(x0 + kInterior), 0, width_);
-      const int i1 = clamped_int(std::floor(x1 - kInterior), -1, width_ - 1);
-      for (int i = i0; i <= i1; ++i) occupied_[index(i, j)] = 1;
+    // The cells of the convex hull of pts (at most the whole polygon's row extents), calling
+    // visit(i, j) for each.
+    const auto cells_of = [&](const Vec2* pts, std::size_t n, auto&& visit) {
+      double lo = std::numeric_limits<double>::infinity();
+      double hi = -lo;
+      for (std::size_t k = 0; k < n; ++k) {
+        lo = std::min(lo, pts[k].y());
+        hi = std::max(hi, pts[k].y());
+      }
+      const int j0 = clamped_int(std::floor(lo + kInterior), 0, height_);
+      const int j1 = clamped_int(std::floor(hi - kInterior), -1, height_ - 1);
+      for (int j = j0; j <= j1; ++j) {
+        double x0 = 0.0;
+        double x1 = 0.0;
+        if (!strip_extent(pts, n, j + kInterior, j + 1.0 - kInterior, x0, x1)) continue;
+        const int i0 = clamped_int(std::floor(x0 + kInterior), 0, width_);
+        const int i1 = clamped_int(std::floor(x1 - kInterior), -1, width_ - 1);
+        for (int i = i0; i <= i1; ++i) visit(i, j);
+      }
+    };
+    // The exact layer: the cells an edge meets are partial, the others hard when their centre lies
+    // inside the polygon (the row extents of a non-convex polygon also cover its concavities:
+    // those cells are partial, the exact test finds them free).
+    const auto shape = static_cast<std::uint32_t>(shapes_.size());
+    shapes_.push_back({g, g.size() >= 3});
+    edge_cells.clear();
+    for (std::size_t k = 0; k < g.size(); ++k) {
+      if (!shapes_.back().closed && k + 1 == g.size() && g.size() > 1) break;
+      const std::array<Vec2, 2> e{g[k], g[(k + 1) % g.size()]};
+      cells_of(e.data(), 2, [&](int i, int j) { edge_cells.push_back(static_cast<std::uint32_t>(index(i, j))); });
     }
+    std::sort(edge_cells.begin(), edge_cells.end());
+    edge_cells.erase(std::unique(edge_cells.begin(), edge_cells.end()), edge_cells.end());
+    const bool closed = shapes_.back().closed;
+    // A lane edge decides the cells it crosses (their part outside the lanes is found by
+    // inside_drivable), so those are partial even where the centre lies outside.
+    const bool lane_edge = static_cast<std::size_t>(&poly - polygons.data()) < lane_edges;
+    cells_of(g.data(), g.size(), [&](int i, int j) {
+      const std::size_t c = index(i, j);
+      if (lane_edge) {
+        occupied_[c] = 1;
+        hard_[c] = 0;
+        partial_.emplace_back(static_cast<std::uint32_t>(c), shape);
+        return;
+      }
+      if (!std::binary_search(edge_cells.begin(), edge_cells.end(), static_cast<std::uint32_t>(c))) {
+        // No edge meets the cell's interior: it lies inside the polygon entirely (hard) or
+        // outside entirely (a concavity: left as it is).
+        if (!closed || !grid_point_in_polygon(g, {i + 0.5, j + 0.5})) return;
+        occupied_[c] = 1;
+        hard_[c] = 1;
+        return;
+      }
+      occupied_[c] = 1;
+      if (hard_[c] == 0) partial_.emplace_back(static_cast<std::uint32_t>(c), shape);
+    });
   }
   return true;
 }
@@ -253,6 +345,25 @@ long long Costmap::occupied_in_box(int c0, int r0, int c1, int r1) const {
 
 void Costmap::precompute(const StopCondition& stop) {
   const std::size_t stride = static_cast<std::size_t>(width_) + 1;
+  if (!partial_.empty()) {
+    std::sort(partial_.begin(), partial_.end());
+    partial_.erase(std::unique(partial_.begin(), partial_.end()), partial_.end());
+    // A cell made hard by a later shape needs no exact test.
+    partial_.erase(std::remove_if(partial_.begin(), partial_.end(), [&](const auto& e) { return hard_[e.first] != 0; }),
+                   partial_.end());
+    hard_prefix_.assign(stride * (static_cast<std::size_t>(height_) + 1), 0);
+    for (int j = 0; j < height_; ++j) {
+      const std::int32_t* below = hard_prefix_.data() + static_cast<std::size_t>(j) * stride;
+      std::int32_t* box = hard_prefix_.data() + static_cast<std::size_t>(j + 1) * stride;
+      std::int32_t row = 0;
+      for (int i = 0; i < width_; ++i) {
+        row += hard_[index(i, j)] != 0 ? 1 : 0;
+        box[i + 1] = below[i + 1] + row;
+      }
+    }
+  } else {
+    hard_prefix_.clear();
+  }
   box_prefix_.assign(stride * (static_cast<std::size_t>(height_) + 1), 0);
   for (int j = 0; j < height_; ++j) {
     if (stop_now(stop, j, stopped_)) return;

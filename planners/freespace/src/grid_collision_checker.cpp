@@ -25,7 +25,10 @@ inline int cell_first(double v) {
 
 // True when an occupied cell meets the convex polygon q (count vertices in order, grid frame in
 // cell units, inside the grid) in the rows j0..j1, which cover the rows its y extent touches.
-bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, int j1) {
+// With `partial` (a costmap with an exact layer), only a hard cell counts; the shapes of the
+// partial cells met are appended to *partial for the caller's exact test.
+bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, int j1,
+                  std::vector<std::uint32_t>* partial) {
   const int rows = j1 - j0 + 1;
   // Each edge adds its exact x range within every row strip it crosses; a convex polygon's extent
   // in a strip is the union of its edges' ranges there (a strip that cuts the polygon cuts its
@@ -73,9 +76,76 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
     // The cells the closed range [lo, hi] touches (a range ending on a cell boundary touches the
     // cell beyond it).
     const int j = j0 + r;
-    if (m.occupied_in_box_inside(std::max(0, cell_first(lo[k])), j, cell_last(hi[k]), j) > 0) return true;
+    const int c0 = std::max(0, cell_first(lo[k]));
+    const int c1 = cell_last(hi[k]);
+    if (m.occupied_in_box_inside(c0, j, c1, j) == 0) continue;
+    if (partial == nullptr || m.hard_in_box_inside(c0, j, c1, j) > 0) return true;
+    for (int i = c0; i <= c1; ++i) {
+      if (m.occupied(i, j)) m.partial_shapes(i, j, *partial);
+    }
   }
   return false;
+}
+
+// Exact test of the closed rectangle r (corners in order, grid frame) against the closed segment
+// [p, q]: true when they share a point. Separating axes: the rectangle's two sides and the
+// segment's normal.
+bool segment_meets_rectangle(const std::array<Vec2, 4>& r, const Vec2& p, const Vec2& q) {
+  const Vec2 centre = 0.5 * (r[0] + r[2]);
+  const Vec2 sides[2] = {r[1] - r[0], r[3] - r[0]};
+  double half_proj[2] = {0.0, 0.0};
+  Vec2 axes[2];
+  for (int a = 0; a < 2; ++a) {
+    const double len = sides[a].norm();
+    axes[a] = len > 0.0 ? Vec2(sides[a] / len) : Vec2(a == 0 ? Vec2(1.0, 0.0) : Vec2(0.0, 1.0));
+    half_proj[a] = 0.5 * len;
+    const double pa = (p - centre).dot(axes[a]);
+    const double qa = (q - centre).dot(axes[a]);
+    if (std::min(pa, qa) > half_proj[a] || std::max(pa, qa) < -half_proj[a]) return false;
+  }
+  const Vec2 d = q - p;
+  const double dl = d.norm();
+  if (dl > 0.0) {
+    const Vec2 n(-d.y() / dl, d.x() / dl);
+    const double dist = std::abs((p - centre).dot(n));
+    const double radius = half_proj[0] * std::abs(axes[0].dot(n)) + half_proj[1] * std::abs(axes[1].dot(n));
+    if (dist > radius) return false;
+  }
+  return true;
+}
+
+// Even-odd point in polygon (grid frame).
+bool inside(const std::vector<Vec2>& poly, const Vec2& p) {
+  bool in = false;
+  const std::size_t n = poly.size();
+  for (std::size_t i = 0, k = n - 1; i < n; k = i++) {
+    const Vec2& a = poly[i];
+    const Vec2& b = poly[k];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x())) {
+      in = !in;
+    }
+  }
+  return in;
+}
+
+// The exact test of the rectangle against the shapes listed (indices into m.shapes(), any order,
+// duplicates allowed): true when it meets one of them or leaves the drivable polygons.
+bool shapes_hit(const Costmap& m, const std::array<Vec2, 4>& r, std::vector<std::uint32_t>& ids) {
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  const Vec2 centre = 0.5 * (r[0] + r[2]);
+  for (const std::uint32_t id : ids) {
+    const Costmap::Shape& s = m.shapes()[id];
+    const std::size_t n = s.points.size();
+    const std::size_t edges = s.closed ? n : std::max<std::size_t>(1, n - 1);
+    for (std::size_t k = 0; k < edges; ++k) {
+      if (segment_meets_rectangle(r, s.points[k], s.points[(k + 1) % n])) return true;
+    }
+    // No edge meets the rectangle: it is inside the polygon entirely or not at all.
+    if (s.closed && inside(s.points, centre)) return true;
+  }
+  // No lane edge meets it either: inside the lanes entirely or not at all.
+  return !m.inside_drivable(centre);
 }
 
 }  // namespace
@@ -224,17 +294,23 @@ bool GridCollisionChecker::collides_exact(const GridPose& g) const {
   int j0 = 0;
   int j1 = 0;
   if (box_empty(x_lo, y_lo, x_hi, y_hi, j0, j1)) return false;
-  if (nx * ny == 1) return polygon_hits(costmap_, corners.data(), 4, j0, j1);
-  // Otherwise only the pieces whose own box holds an occupied cell need the exact row walk.
-  for (int i = 0; i < nx; ++i) {
-    for (int k = 0; k < ny; ++k) {
-      const std::array<Vec2, 4> q{point(i, k), point(i + 1, k), point(i + 1, k + 1), point(i, k + 1)};
-      bounds(q, x_lo, y_lo, x_hi, y_hi);
-      if (box_empty(x_lo, y_lo, x_hi, y_hi, j0, j1)) continue;
-      if (polygon_hits(costmap_, q.data(), 4, j0, j1)) return true;
+  // With an exact layer, partial cells collect their shapes for the exact test at the end.
+  std::vector<std::uint32_t> shapes;
+  std::vector<std::uint32_t>* partial = costmap_.has_partial() ? &shapes : nullptr;
+  if (nx * ny == 1) {
+    if (polygon_hits(costmap_, corners.data(), 4, j0, j1, partial)) return true;
+  } else {
+    // Otherwise only the pieces whose own box holds an occupied cell need the exact row walk.
+    for (int i = 0; i < nx; ++i) {
+      for (int k = 0; k < ny; ++k) {
+        const std::array<Vec2, 4> q{point(i, k), point(i + 1, k), point(i + 1, k + 1), point(i, k + 1)};
+        bounds(q, x_lo, y_lo, x_hi, y_hi);
+        if (box_empty(x_lo, y_lo, x_hi, y_hi, j0, j1)) continue;
+        if (polygon_hits(costmap_, q.data(), 4, j0, j1, partial)) return true;
+      }
     }
   }
-  return false;
+  return !shapes.empty() && shapes_hit(costmap_, corners, shapes);
 }
 
 }  // namespace pullout

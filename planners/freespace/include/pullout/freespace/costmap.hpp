@@ -14,6 +14,13 @@
 //  - the drivable area (lane polygons) and static object footprints, rasterised conservatively: a
 //    cell is free only when it lies entirely inside the lanes and touches no object.
 //
+// Exact shapes: the polygons and lane edges rasterised here are kept (grid frame). Every occupied
+// cell is then either hard (entirely covered: outside the lanes and crossed by no lane edge, inside
+// an object and crossed by none of its edges, or a cell of a request's occupancy grid) or partial
+// (only partly covered: the shapes that meet it are listed). occupied() stays conservative; the
+// collision checker tests partial cells against the listed shapes exactly (partial_shapes,
+// hard_in_box_inside, inside_drivable). A grid from a request has no shapes: all its cells are hard.
+//
 // The distance transform is exact for cell centres (Felzenszwalb & Huttenlocher, "Distance
 // Transforms of Sampled Functions", Theory of Computing 8, 2012).
 //
@@ -51,10 +58,33 @@ class Costmap {
                                const std::vector<std::pair<Vec2, Vec2>>& drivable_outline,
                                const std::vector<Polygon>& obstacles, const StopCondition& stop = {});
 
-  // Marks every cell whose interior a polygon (map frame) meets as occupied (conservative;
-  // non-convex polygons are filled row by row between their extreme points; a segment marks the
-  // cells it passes through). Updates the precomputation.
+  // Marks every cell whose interior a polygon (map frame) meets as occupied (a segment marks the
+  // cells it passes through; a cell in a non-convex polygon's concavity that no edge meets stays
+  // as it was). The polygons join the exact layer. Updates the precomputation.
   void add_obstacles(const std::vector<Polygon>& polygons, const StopCondition& stop = {});
+
+  // A polygon or lane edge kept for the exact test, grid frame in cell units. `closed`: a polygon
+  // (its interior counts); otherwise a polyline (a lane edge segment, two points).
+  struct Shape {
+    std::vector<Vec2> points;
+    bool closed{true};
+  };
+  // True when some occupied cell is partial (the exact layer is in use).
+  bool has_partial() const { return !partial_.empty(); }
+  // Hard (entirely covered) cells in the box, as occupied_in_box_inside.
+  int hard_in_box_inside(int c0, int r0, int c1, int r1) const {
+    if (hard_prefix_.empty()) return occupied_in_box_inside(c0, r0, c1, r1);
+    const std::size_t stride = static_cast<std::size_t>(width_) + 1;
+    const std::int32_t* lo = hard_prefix_.data() + static_cast<std::size_t>(r0) * stride;
+    const std::int32_t* hi = hard_prefix_.data() + static_cast<std::size_t>(r1 + 1) * stride;
+    return hi[c1 + 1] - hi[c0] - lo[c1 + 1] + lo[c0];
+  }
+  // Appends the indices (into shapes()) of the shapes meeting partial cell (ix, iy) in the grid.
+  void partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) const;
+  const std::vector<Shape>& shapes() const { return shapes_; }
+  // Whether grid point p (cell units) lies inside the drivable polygons (always true for a costmap
+  // without drivable polygons). Even-odd per polygon, union over polygons.
+  bool inside_drivable(const Vec2& p_G) const;
 
   // Why the last build step was cut short (see the file comment); kNone when complete.
   StopReason stopped() const { return stopped_; }
@@ -107,7 +137,10 @@ class Costmap {
   enum Deferred { kDeferred };  // tag: the cells are set, the precomputation is left to the caller
   Costmap(const Pose2& origin, double resolution, int width, int height, std::vector<std::uint8_t> occupied, Deferred);
   // Marks the polygons' cells (add_obstacles without the precomputation); false when stopped.
-  bool mark(const std::vector<Polygon>& polygons, const StopCondition& stop);
+  // The first `lane_edges` polygons are lane edges (see from_polygons).
+  bool mark(const std::vector<Polygon>& polygons, const StopCondition& stop, std::size_t lane_edges = 0);
+  // Makes the exact layer: hard_ from occupied_ (when not made yet).
+  void ensure_hard();
   void precompute(const StopCondition& stop);
 
   Pose2 origin_;
@@ -122,6 +155,14 @@ class Costmap {
   // row's count is the difference of two neighbouring table rows).
   std::vector<std::int32_t> box_prefix_;
   StopReason stopped_{StopReason::kNone};
+  // The exact layer (see the file comment): hard_ per cell (empty: every occupied cell is hard),
+  // its summed-area table, the (cell index, shape index) pairs of partial cells sorted, the shapes,
+  // and the drivable polygons (grid frame).
+  std::vector<std::uint8_t> hard_;
+  std::vector<std::int32_t> hard_prefix_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> partial_;
+  std::vector<Shape> shapes_;
+  std::vector<std::vector<Vec2>> drivable_;
 };
 
 // The column extent of a convex polygon (grid frame, cell units) within the horizontal strip
