@@ -77,14 +77,13 @@ ReturnCode VehicleIdFilterFactory::create_content_filter(const char* filter_clas
 
 ReturnCode VehicleIdFilterFactory::delete_content_filter(const char* /*filter_class_name*/,
                                                          dds::IContentFilter* filter_instance) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    auto it = std::find_if(filters_.begin(), filters_.end(),
-                           [&](const std::unique_ptr<Filter>& f) { return f.get() == filter_instance; });
-    if (it == filters_.end()) return ReturnCode::RETCODE_BAD_PARAMETER;
-    filters_.erase(it);
-  }
+  // The hook first: a writer may be evaluating this filter until the hook returns.
   if (change_hook_) change_hook_();
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = std::find_if(filters_.begin(), filters_.end(),
+                         [&](const std::unique_ptr<Filter>& f) { return f.get() == filter_instance; });
+  if (it == filters_.end()) return ReturnCode::RETCODE_BAD_PARAMETER;
+  filters_.erase(it);
   return ReturnCode::RETCODE_OK;
 }
 
