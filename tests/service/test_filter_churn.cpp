@@ -19,6 +19,8 @@
 #include <thread>
 #include <vector>
 
+#include <fastrtps/attributes/LibrarySettingsAttributes.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -27,8 +29,6 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/topic/ContentFilteredTopic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-#include <fastrtps/attributes/LibrarySettingsAttributes.h>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 
 #include "pullout/config/config.hpp"
 #include "pullout/idl/guarded_type.hpp"
@@ -72,9 +72,9 @@ class FilteredReaders {
     }
     for (int i = first; i < first + count; ++i) {
       const std::string id = vehicle_name(i);
-      dds::ContentFilteredTopic* filtered = participant_->create_contentfilteredtopic(
-          std::string(idl::kStatusTopic) + "/" + id, topic_, idl::kVehicleFilterExpression, {id},
-          idl::kVehicleFilterClass);
+      dds::ContentFilteredTopic* filtered =
+          participant_->create_contentfilteredtopic(std::string(idl::kStatusTopic) + "/" + id, topic_,
+                                                    idl::kVehicleFilterExpression, {id}, idl::kVehicleFilterClass);
       if (filtered == nullptr) throw std::runtime_error("content filtered topic");
       dds::DataReader* reader = subscriber_->create_datareader(filtered, qos);
       if (reader == nullptr) throw std::runtime_error("reader");
