@@ -64,15 +64,21 @@ ReturnCode VehicleIdFilterFactory::create_content_filter(const char* filter_clas
       filter_parameters[0] == nullptr) {
     return ReturnCode::RETCODE_BAD_PARAMETER;
   }
+  const bool new_entry = filter_instance == nullptr;
   auto filter = std::make_unique<Filter>(filter_parameters[0]);
-  std::lock_guard<std::mutex> lock(mutex_);
-  filter_instance = filter.get();
-  filters_.push_back(std::move(filter));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    filter_instance = filter.get();
+    filters_.push_back(std::move(filter));
+  }
+  if (new_entry && change_hook_) change_hook_();
   return ReturnCode::RETCODE_OK;
 }
 
 ReturnCode VehicleIdFilterFactory::delete_content_filter(const char* /*filter_class_name*/,
                                                          dds::IContentFilter* filter_instance) {
+  // The hook first: a writer may be evaluating this filter until the hook returns.
+  if (change_hook_) change_hook_();
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = std::find_if(filters_.begin(), filters_.end(),
                          [&](const std::unique_ptr<Filter>& f) { return f.get() == filter_instance; });

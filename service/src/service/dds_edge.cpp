@@ -4,10 +4,14 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
 #include <cstring>
 #include <deque>
 #include <set>
 #include <sstream>
+#include <thread>
 #include <utility>
 
 #include <fastdds/rtps/builtin/data/ParticipantProxyData.h>
@@ -20,6 +24,7 @@
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
@@ -114,6 +119,123 @@ void check_endpoint_qos(const char* profile, const Qos& qos, dds::DurabilityQosP
 
 }  // namespace
 
+// Fast DDS 2.9.1 keeps a writer's writer-side reader filters in a map that DataWriter::write (and
+// unregister_instance) walks under the writer's lock, while a discovery thread adds a reader's
+// entry (DISCOVERED_READER) or erases it (REMOVED_READER) after releasing that lock
+// (DataWriterImpl::process_reader_filter_info / remove_reader_filter, called from
+// StatefulWriter::matched_reader_add / matched_reader_remove "without locks taken"; upstream
+// fixed the removal for 3.0 by taking the writer's lock there). A write during such a change walks
+// a map being rebalanced and freed: the service crashed in ReaderFilterCollection::
+// update_filter_info when hundreds of vehicles left (bench/RESULTS.md, Load).
+//
+// The gate keeps the service's writes out of those changes. The only code of ours that runs inside
+// one is the filter factory: Fast DDS calls create_content_filter right before adding an entry and
+// delete_content_filter right before erasing one, on the discovery thread, and after the change
+// returns it calls the writer's on_publication_matched on the same thread (EDP pairing/unpairing),
+// then, for a removal, the participant's on_subscriber_discovery. So the factory's hook holds the
+// gate (after waiting for writes in progress), and those callbacks release it; writes wait while
+// a discovery thread holds it. Several discovery threads may hold it at once (they never wait for
+// each other: one may hold the PDP lock the other needs before its release).
+//
+// A change without a matched callback after it (a known reader whose QoS changed so that its
+// filter is dropped or first added) releases at that thread's next callback; writes stop waiting
+// for such a hold after kStaleHold, so a missed release delays writes, it never stops them.
+class DdsEdge::FilterGate {
+ public:
+  static constexpr std::chrono::milliseconds kStaleHold{500};
+
+  // On a discovery thread, from the filter factory: a filter map is about to change.
+  void hold() {
+    if (own_call_) return;  // our own writer deletion (destroy, forget_secure_vehicle)
+    std::unique_lock<std::mutex> lock(mutex_);
+    const auto self = std::this_thread::get_id();
+    auto it = holds_.find(self);
+    if (it != holds_.end()) {
+      it->second = Clock::now();
+      return;
+    }
+    ++pending_;
+    changed_.wait(lock, [&] { return writing_ == 0; });
+    --pending_;
+    holds_.emplace(self, Clock::now());
+  }
+
+  // On a discovery thread, after Fast DDS's change: no-op when this thread holds nothing.
+  void release() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (holds_.erase(std::this_thread::get_id()) != 0) changed_.notify_all();
+  }
+
+  // A write section (RAII): waits until no discovery thread holds the gate or wants to.
+  class Write {
+   public:
+    explicit Write(FilterGate& gate) : gate_(gate) { gate_.enter(); }
+    ~Write() { gate_.leave(); }
+    Write(const Write&) = delete;
+    Write& operator=(const Write&) = delete;
+
+   private:
+    FilterGate& gate_;
+  };
+
+  // Marks the calling thread as deleting writers (their filters are deleted without a change
+  // that a discovery callback would end).
+  class OwnCall {
+   public:
+    OwnCall() { own_call_ = true; }
+    ~OwnCall() { own_call_ = false; }
+    OwnCall(const OwnCall&) = delete;
+    OwnCall& operator=(const OwnCall&) = delete;
+  };
+
+ private:
+  using Clock = std::chrono::steady_clock;
+
+  void enter() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      // Holds older than kStaleHold are not waited for (see above).
+      Clock::time_point newest{};
+      for (const auto& [thread, since] : holds_) newest = std::max(newest, since);
+      const bool held = !holds_.empty() && Clock::now() - newest < kStaleHold;
+      if (pending_ == 0 && !held) break;
+      if (held) {
+        changed_.wait_until(lock, newest + kStaleHold);
+      } else {
+        changed_.wait(lock);
+      }
+    }
+    ++writing_;
+  }
+
+  void leave() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (--writing_ == 0) changed_.notify_all();
+  }
+
+  static thread_local bool own_call_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::map<std::thread::id, Clock::time_point> holds_;
+  int pending_{0};
+  int writing_{0};
+};
+
+thread_local bool DdsEdge::FilterGate::own_call_ = false;
+
+// The filtering writers' listener: Fast DDS calls on_publication_matched on the discovery thread
+// right after it added or removed a reader, and its filter (FilterGate).
+class DdsEdge::MatchedListener final : public dds::DataWriterListener {
+ public:
+  explicit MatchedListener(FilterGate& gate) : gate_(gate) {}
+  void on_publication_matched(dds::DataWriter* /*writer*/, const dds::PublicationMatchedStatus& /*info*/) override {
+    gate_.release();
+  }
+
+ private:
+  FilterGate& gate_;
+};
+
 // Remembers the partitions of every remote writer the participant discovers (with security, the
 // access control plugin has checked them against the writer's permissions before the match).
 //
@@ -130,13 +252,15 @@ void check_endpoint_qos(const char* profile, const Qos& qos, dds::DurabilityQosP
 // writer wins. Each one that appears is logged as a warning, and counted (other_services).
 class DdsEdge::Discovery final : public dds::DomainParticipantListener {
  public:
-  // secure: the partitions of readers and writers matter only in secure mode.
-  Discovery(dds::GuardCondition& wake, bool secure, int domain_id)
-      : wake_(wake), secure_(secure), domain_id_(domain_id) {}
+  // secure: the partitions of readers and writers matter only in secure mode. gate: released by
+  // every discovery callback (FilterGate).
+  Discovery(dds::GuardCondition& wake, bool secure, int domain_id, FilterGate& gate)
+      : wake_(wake), secure_(secure), domain_id_(domain_id), gate_(gate) {}
 
   void on_participant_discovery(dds::DomainParticipant* /*participant*/,
                                 eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+    gate_.release();
     const auto& guid_prefix = info.info.m_guid.guidPrefix;
     std::lock_guard<std::mutex> lock(mutex_);
     if (info.status == Status::DISCOVERED_PARTICIPANT &&
@@ -175,6 +299,7 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   void on_subscriber_discovery(dds::DomainParticipant* /*participant*/,
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::ReaderDiscoveryInfo;
+    gate_.release();  // after a removal; before an addition this thread holds nothing
     if (!secure_ || info.status == Status::REMOVED_READER) return;
     const std::string topic = info.info.topicName().to_string();
     if (topic != kPathTopic && topic != kStatusTopic) return;
@@ -197,6 +322,7 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   void on_publisher_discovery(dds::DomainParticipant* /*participant*/,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo;
+    gate_.release();
     if (!secure_) return;  // only secure mode asks writer_partition_is
     const auto& guid = info.info.guid();
     std::lock_guard<std::mutex> lock(mutex_);
@@ -240,6 +366,7 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   dds::GuardCondition& wake_;
   const bool secure_;
   const int domain_id_;
+  FilterGate& gate_;
   mutable std::mutex mutex_;
   std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> partitions_;
   std::set<std::string> pending_readers_;
@@ -298,7 +425,10 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   }
   // The discovery callbacks are not masked by the StatusMask: none keeps every other status
   // (data available, matches) off the listener, on the dispatcher's wait set.
-  discovery_ = std::make_unique<Discovery>(discovery_wake_, secure_, config.domain_id);
+  filter_gate_ = std::make_unique<FilterGate>();
+  matched_listener_ = std::make_unique<MatchedListener>(*filter_gate_);
+  filter_factory_.set_change_hook([gate = filter_gate_.get()] { gate->hold(); });
+  discovery_ = std::make_unique<Discovery>(discovery_wake_, secure_, config.domain_id, *filter_gate_);
   participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
   if (participant_ == nullptr) {
     if (secure_) {
@@ -369,7 +499,9 @@ void DdsEdge::create_entities(const DdsConfig& config) {
           "receives every vehicle's samples",
           profile);
     }
-    dds::DataWriter* writer = publisher_->create_datawriter(topic, qos, nullptr, dds::StatusMask::none());
+    // The listener only ends filter changes (FilterGate); matches stay on the status condition.
+    dds::DataWriter* writer =
+        publisher_->create_datawriter(topic, qos, matched_listener_.get(), dds::StatusMask::publication_matched());
     if (writer == nullptr) throw missing_profile(what, profile);
     return writer;
   };
@@ -390,6 +522,7 @@ void DdsEdge::check_qos() const {
 
 void DdsEdge::destroy() noexcept {
   if (participant_ == nullptr) return;
+  const FilterGate::OwnCall own_call;  // the writers' filters are deleted with them
   try {
     if (participant_->delete_contained_entities() != ReturnCode_t::RETCODE_OK) {
       spdlog::error("DDS shutdown: cannot delete the participant's entities");
@@ -440,10 +573,10 @@ dds::DataWriter* DdsEdge::writer_for(const std::string& vehicle_id, bool path) {
     VehicleWriters writers;
     writers.publisher = participant_->create_publisher(qos);
     if (writers.publisher != nullptr) {
-      writers.path = writers.publisher->create_datawriter_with_profile(path_topic_, kPathWriterProfile, nullptr,
-                                                                       dds::StatusMask::none());
-      writers.status = writers.publisher->create_datawriter_with_profile(status_topic_, kStatusWriterProfile, nullptr,
-                                                                         dds::StatusMask::none());
+      writers.path = writers.publisher->create_datawriter_with_profile(
+          path_topic_, kPathWriterProfile, matched_listener_.get(), dds::StatusMask::publication_matched());
+      writers.status = writers.publisher->create_datawriter_with_profile(
+          status_topic_, kStatusWriterProfile, matched_listener_.get(), dds::StatusMask::publication_matched());
     }
     if (writers.path == nullptr || writers.status == nullptr) {
       spdlog::error("vehicle '{}': cannot create its path/status writers in partition '{}' (permissions?)", vehicle_id,
@@ -469,6 +602,7 @@ void DdsEdge::forget_secure_vehicle(const std::string& vehicle_id) {
   // The path and status locks: no write of this vehicle is in progress on its writers.
   std::scoped_lock writes(path_mutex_, status_mutex_);
   std::lock_guard<std::mutex> lock(vehicle_writers_mutex_);
+  const FilterGate::OwnCall own_call;  // the writers' filters are deleted with them
   const auto it = vehicle_writers_.find(vehicle_id);
   if (it == vehicle_writers_.end()) return;
   delete_vehicle_writers(it->second);
@@ -497,6 +631,7 @@ bool DdsEdge::forget_vehicle(const std::string& vehicle_id) {
     msg::PullOutPath key;
     key.vehicle_id(vehicle_id);
     std::lock_guard<std::mutex> lock(path_mutex_);
+    const FilterGate::Write gate(*filter_gate_);
     const ReturnCode_t rc = path_writer_->unregister_instance(&key, dds::HANDLE_NIL);
     if (rc != ReturnCode_t::RETCODE_OK) {
       spdlog::error("unregister {} instance of vehicle '{}' failed (code {})", kPathTopic, vehicle_id, rc());
@@ -507,6 +642,7 @@ bool DdsEdge::forget_vehicle(const std::string& vehicle_id) {
     msg::PullOutStatus key;
     key.vehicle_id(vehicle_id);
     std::lock_guard<std::mutex> lock(status_mutex_);
+    const FilterGate::Write gate(*filter_gate_);
     const ReturnCode_t rc = status_writer_->unregister_instance(&key, dds::HANDLE_NIL);
     if (rc != ReturnCode_t::RETCODE_OK) {
       spdlog::error("unregister {} instance of vehicle '{}' failed (code {})", kStatusTopic, vehicle_id, rc());
@@ -523,6 +659,7 @@ bool DdsEdge::publish_path(const PullOutPath& path) {
     std::lock_guard<std::mutex> lock(path_mutex_);
     try {
       dds::DataWriter* writer = writer_for(path.vehicle_id, true);
+      const FilterGate::Write gate(*filter_gate_);
       ok = writer != nullptr && writer->write(&sample);
     } catch (const std::exception& e) {
       spdlog::error("write {}: {}", kPathTopic, e.what());
@@ -542,6 +679,7 @@ bool DdsEdge::publish_status(const PullOutStatus& status) {
     std::lock_guard<std::mutex> lock(status_mutex_);
     try {
       dds::DataWriter* writer = writer_for(status.vehicle_id, false);
+      const FilterGate::Write gate(*filter_gate_);
       ok = writer != nullptr && writer->write(&sample);
     } catch (const std::exception& e) {
       spdlog::error("write {}: {}", kStatusTopic, e.what());

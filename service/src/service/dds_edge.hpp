@@ -10,6 +10,8 @@
 // (pullout/idl/vehicle_filter.hpp) is registered on the participant, and each writer evaluates
 // the filters of up to idl::kMaxWriterReaderFilters remote readers (set in code: Fast DDS 2.9's
 // XML has no element for it), so each vehicle's samples are sent to that vehicle's readers only.
+// Fast DDS 2.9.1 changes those filters on a discovery thread without the writer's lock; a gate
+// (FilterGate in dds_edge.cpp) keeps the writes out of such a change.
 //
 // Construction loads the XML and creates everything, or throws DdsSetupError naming the step that
 // failed (after deleting whatever was created). Destruction deletes every entity and the
@@ -116,7 +118,9 @@ class DdsEdge final : public Outbox {
   eprosima::fastdds::dds::DataReader& progress_reader() { return *progress_reader_; }
 
  private:
-  class Discovery;  // the participant listener: discovered writers' partitions, other vendors' participants
+  class Discovery;        // the participant listener: discovered writers' partitions, other vendors' participants
+  class FilterGate;       // keeps the writes out of Fast DDS's changes to the writers' reader filters
+  class MatchedListener;  // the filtering writers' listener: ends such a change (FilterGate::release)
   // One vehicle's writers in secure mode, in a publisher whose partition is the vehicle id.
   struct VehicleWriters {
     eprosima::fastdds::dds::Publisher* publisher{nullptr};
@@ -132,7 +136,10 @@ class DdsEdge final : public Outbox {
   void delete_vehicle_writers(VehicleWriters& writers) noexcept;
   void forget_secure_vehicle(const std::string& vehicle_id);
 
-  // Registered with the participant: declared first, destroyed after it.
+  // Registered with the participant: declared first, destroyed after it (with the gate and the
+  // writers' listener, which the factory and the writers call).
+  std::unique_ptr<FilterGate> filter_gate_;
+  std::unique_ptr<MatchedListener> matched_listener_;
   idl::VehicleIdFilterFactory filter_factory_;
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
   eprosima::fastdds::dds::Publisher* publisher_{nullptr};

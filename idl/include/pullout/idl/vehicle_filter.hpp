@@ -21,6 +21,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -67,10 +68,19 @@ class VehicleIdFilterFactory final : public eprosima::fastdds::dds::IContentFilt
   ReturnCode_t delete_content_filter(const char* filter_class_name,
                                      eprosima::fastdds::dds::IContentFilter* filter_instance) override;
 
+  // Called on the calling thread when a new filter was created (after creating it) or before a
+  // filter is deleted (before freeing it: a writer may still be evaluating it): at a writer, Fast
+  // DDS 2.9.1 adds or erases that reader's entry in the writer's filter map right after the
+  // factory call returns. The service uses it to keep its writes out
+  // of that change (service/src/service/dds_edge.cpp, FilterGate). Not called when a create
+  // fails or when it updates an existing filter. Set before the factory is registered.
+  void set_change_hook(std::function<void()> hook) { change_hook_ = std::move(hook); }
+
  private:
   class Filter;
   std::mutex mutex_;
   std::vector<std::unique_ptr<Filter>> filters_;
+  std::function<void()> change_hook_;
 };
 
 }  // namespace pullout::idl
