@@ -425,11 +425,14 @@ class CycloneInteropDynamicReaders : public CycloneInterop {
     std::stringstream text;
     text << in.rdbuf();
     std::string xml = text.str();
-    const std::string from = "<historyMemoryPolicy>PREALLOCATED_WITH_REALLOC</historyMemoryPolicy>";
+    // The service's readers are PREALLOCATED (a payload cap), the client's PREALLOCATED_WITH_REALLOC.
     const std::string to = "<historyMemoryPolicy>DYNAMIC_REUSABLE</historyMemoryPolicy>";
     int replaced = 0;
-    for (auto at = xml.find(from); at != std::string::npos; at = xml.find(from, at + to.size()), ++replaced) {
-      xml.replace(at, from.size(), to);
+    for (const std::string from : {"<historyMemoryPolicy>PREALLOCATED_WITH_REALLOC</historyMemoryPolicy>",
+                                   "<historyMemoryPolicy>PREALLOCATED</historyMemoryPolicy>"}) {
+      for (auto at = xml.find(from); at != std::string::npos; at = xml.find(from, at + to.size()), ++replaced) {
+        xml.replace(at, from.size(), to);
+      }
     }
     EXPECT_EQ(replaced, 4) << "the four readers of loopback.xml";
     const std::string profiles = dir_.write_file("dynamic.xml", xml);
