@@ -161,13 +161,14 @@ void VehicleRegistry::reject_full(const PullOutRequest& request) {
   status.state = ExecutionState::kRejected;
   status.error = reason;
   status.stamp_ns = now_ns();
+  // Counted before it is written: whoever has received the reply finds it in the metrics.
+  rejected_full_count_.fetch_add(1);
+  if (options_.on_reply) options_.on_reply(status);
   outbox_.publish_path(path);
   outbox_.publish_status(status);
   // Written at once (synchronous publication); the instances must not stay for a vehicle that has
   // no session.
   outbox_.forget_vehicle(request.vehicle_id);
-  rejected_full_count_.fetch_add(1);
-  if (options_.on_reply) options_.on_reply(status);
   // One line per second at most: a flood of new ids must not flood the log.
   const auto now = Clock::now();
   ++full_since_log_;
@@ -211,7 +212,7 @@ std::optional<PlanningJob> VehicleRegistry::settle(Slot& slot, std::unique_lock<
   }
   if (effects.status && !undeliverable) {
     effects.status->stamp_ns = now_ns();
-    outbox_.publish_status(*effects.status);
+    // Counted before it is written: whoever has received the reply finds it in the metrics.
     const int outcome = outcome_class(effects.status->state);
     if (options_.on_reply && outcome >= 0 &&
         (effects.status->request_id != slot.replied_request_id || outcome != slot.replied_outcome)) {
@@ -219,6 +220,7 @@ std::optional<PlanningJob> VehicleRegistry::settle(Slot& slot, std::unique_lock<
       slot.replied_outcome = outcome;
       options_.on_reply(*effects.status);
     }
+    outbox_.publish_status(*effects.status);
   }
   publishing.unlock();
   if (undeliverable) {
