@@ -192,24 +192,6 @@ void Costmap::ensure_hard() {
   if (hard_.size() != occupied_.size()) hard_ = occupied_;
 }
 
-namespace {
-
-// Even-odd point in polygon (grid frame).
-bool grid_point_in_polygon(const std::vector<Vec2>& poly, const Vec2& p) {
-  bool in = false;
-  const std::size_t n = poly.size();
-  for (std::size_t i = 0, k = n - 1; i < n; k = i++) {
-    const Vec2& a = poly[i];
-    const Vec2& b = poly[k];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x())) {
-      in = !in;
-    }
-  }
-  return in;
-}
-
-}  // namespace
-
 void Costmap::partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) const {
   const auto cell = static_cast<std::uint32_t>(index(ix, iy));
   auto it = std::lower_bound(partial_.begin(), partial_.end(), std::make_pair(cell, std::uint32_t{0}));
@@ -218,9 +200,8 @@ void Costmap::partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) co
 
 bool Costmap::inside_drivable(const Vec2& p_G) const {
   if (drivable_.empty()) return true;
-  return std::any_of(drivable_.begin(), drivable_.end(), [&](const std::vector<Vec2>& poly) {
-    return poly.size() >= 3 && grid_point_in_polygon(poly, p_G);
-  });
+  return std::any_of(drivable_.begin(), drivable_.end(),
+                     [&](const std::vector<Vec2>& poly) { return poly.size() >= 3 && point_in_polygon(poly, p_G); });
 }
 
 bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& stop, std::size_t lane_edges) {
@@ -289,7 +270,7 @@ bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& st
       if (!std::binary_search(edge_cells.begin(), edge_cells.end(), static_cast<std::uint32_t>(c))) {
         // No edge meets the cell's interior: it lies inside the polygon entirely (hard) or
         // outside entirely (a concavity: left as it is).
-        if (!closed || !grid_point_in_polygon(g, {i + 0.5, j + 0.5})) return;
+        if (!closed || !point_in_polygon(g, {i + 0.5, j + 0.5})) return;
         occupied_[c] = 1;
         hard_[c] = 1;
         return;

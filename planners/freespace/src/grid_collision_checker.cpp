@@ -114,20 +114,6 @@ bool segment_meets_rectangle(const std::array<Vec2, 4>& r, const Vec2& p, const 
   return true;
 }
 
-// Even-odd point in polygon (grid frame).
-bool inside(const std::vector<Vec2>& poly, const Vec2& p) {
-  bool in = false;
-  const std::size_t n = poly.size();
-  for (std::size_t i = 0, k = n - 1; i < n; k = i++) {
-    const Vec2& a = poly[i];
-    const Vec2& b = poly[k];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x())) {
-      in = !in;
-    }
-  }
-  return in;
-}
-
 // The exact test of the rectangle against the shapes listed (indices into m.shapes(), any order,
 // duplicates allowed): true when it meets one of them or leaves the drivable polygons.
 bool shapes_hit(const Costmap& m, const std::array<Vec2, 4>& r, std::vector<std::uint32_t>& ids) {
@@ -142,7 +128,7 @@ bool shapes_hit(const Costmap& m, const std::array<Vec2, 4>& r, std::vector<std:
       if (segment_meets_rectangle(r, s.points[k], s.points[(k + 1) % n])) return true;
     }
     // No edge meets the rectangle: it is inside the polygon entirely or not at all.
-    if (s.closed && inside(s.points, centre)) return true;
+    if (s.closed && point_in_polygon(s.points, centre)) return true;
   }
   // No lane edge meets it either: inside the lanes entirely or not at all.
   return !m.inside_drivable(centre);
