@@ -35,6 +35,7 @@
 #include <CLI/CLI.hpp>
 
 #include "fleet_client.hpp"
+#include "load_average.hpp"
 #include "percentiles.hpp"
 #include "pullout/config/scenario.hpp"
 #include "service_process.hpp"
@@ -68,13 +69,7 @@ double rss_mb(pid_t pid) {
 using pullout::bench::summarize;
 using pullout::bench::Summary;
 
-std::string load_text() {
-  double load[3] = {0, 0, 0};
-  if (::getloadavg(load, 3) != 3) return "?";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.2f %.2f %.2f", load[0], load[1], load[2]);
-  return buf;
-}
+using pullout::bench::load_text;
 
 struct Outcome {
   double latency_ms{-1.0};  // < 0: not answered

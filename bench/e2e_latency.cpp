@@ -51,6 +51,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "load_average.hpp"
 #include "percentiles.hpp"
 #include "pullout/client/client.hpp"
 #include "pullout/config/config.hpp"
@@ -94,13 +95,7 @@ void print_row(const std::string& what, const Summary& s) {
   std::printf("| %s | %zu | %.3f | %.3f | %.3f | %.3f |\n", what.c_str(), s.n, s.p50, s.p90, s.p99, s.max);
 }
 
-std::string load_text() {
-  double load[3] = {0, 0, 0};
-  if (::getloadavg(load, 3) != 3) return "?";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.2f %.2f %.2f", load[0], load[1], load[2]);
-  return buf;
-}
+using pullout::bench::load_text;
 
 // ------------------------------------------------------------------------------------------------
 // The two ping-pong endpoints: one participant from the loopback profile, a writer on one topic

@@ -57,6 +57,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "load_average.hpp"
 #include "percentiles.hpp"
 #include "pullout/client/client.hpp"
 #include "pullout/config/scenario.hpp"
@@ -364,13 +365,7 @@ std::uint64_t udp_rcvbuf_errors() {
   return 0;
 }
 
-std::string load_text() {
-  double load[3] = {0, 0, 0};
-  if (::getloadavg(load, 3) != 3) return "?";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.2f %.2f %.2f", load[0], load[1], load[2]);
-  return buf;
-}
+using pullout::bench::load_text;
 
 struct Options {
   int vehicles{1000};
