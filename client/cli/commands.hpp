@@ -37,11 +37,26 @@ struct RequestOptions {
   OutputOptions output;
 };
 
+struct WatchOptions {
+  int domain_id{0};
+  std::string profiles_file;  // empty: built-in loopback-only DDS profiles
+  double interval_s{1.0};     // redraw period
+  double duration_s{0.0};     // > 0: stop after this long; 0: until interrupted
+  bool once{false};           // print one table once the service's samples have arrived, then exit
+  double wait_s{5.0};         // --once: wait at most this long for the service
+};
+
 int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err);
 int run_request(const RequestOptions& options, std::ostream& out, std::ostream& err);
+// `pullout watch`: 0 when stopped by --duration, --once or an interrupt; 2 bad options; 3 DDS
+// setup failed, or --once found no service within wait_s (the table is printed anyway).
+// `terminal`: redraw in place with ANSI escapes instead of printing one table after another.
+int run_watch(const WatchOptions& options, bool terminal, std::ostream& out, std::ostream& err);
 
 // Makes SIGINT and SIGTERM interrupt run_request's waits (which then return kExitInterrupted)
-// instead of killing the process without deleting its DDS participant.
+// and end run_watch, instead of killing the process without deleting its DDS participant.
 void install_interrupt_handlers();
+// Whether SIGINT or SIGTERM arrived since install_interrupt_handlers().
+bool interrupted();
 
 }  // namespace pullout::cli
