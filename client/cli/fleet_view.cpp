@@ -145,7 +145,7 @@ nlohmann::json fleet_json(const FleetSnapshot& snapshot, const VehicleInfo& vehi
         }
         segments.push_back({{"points", std::move(points)}, {"reverse", reverse}});
       }
-      j["path"] = {{"request_id", path->request_id},
+      j["path"] = {{"request_id", std::to_string(path->request_id)},
                    {"found", path->found},
                    {"planner", to_string(path->planner_type)},
                    {"segments", std::move(segments)}};

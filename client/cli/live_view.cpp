@@ -1,4 +1,5 @@
-// `pullout watch`: the fleet table of a FleetMonitor, redrawn in the terminal.
+// `pullout watch` (the fleet table of a FleetMonitor, redrawn in the terminal) and `pullout view`
+// (its web page).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,8 @@
 #include "commands.hpp"
 #include "fleet_monitor.hpp"
 #include "fleet_view.hpp"
+#include "pullout/config/config.hpp"
+#include "view/view_server.hpp"
 
 namespace pullout::cli {
 
@@ -114,6 +117,69 @@ int run_watch(const WatchOptions& options, bool terminal, std::ostream& out, std
     out << std::flush;
     if (terminal) std::this_thread::sleep_for(kSlice);  // rate limit
   }
+  return kExitFound;
+}
+
+int run_view(const ViewOptions& options, std::ostream& out, std::ostream& err) {
+  if (!(options.duration_s >= 0.0) || !std::isfinite(options.duration_s)) {
+    err << "pullout: --duration must be a non-negative number of seconds\n";
+    return kExitBadInput;
+  }
+  const std::size_t colon = options.http.rfind(':');
+  int port = -1;
+  if (colon != std::string::npos && colon > 0 && colon + 1 < options.http.size() &&
+      options.http.find_first_not_of("0123456789", colon + 1) == std::string::npos &&
+      options.http.size() - colon <= 6) {
+    port = std::stoi(options.http.substr(colon + 1));
+  }
+  if (port < 0 || port > 65535) {
+    err << "pullout: --http must be ADDRESS:PORT (e.g. 127.0.0.1:8080), not '" << options.http << "'\n";
+    return kExitBadInput;
+  }
+  ViewServerOptions server_options;
+  server_options.address = options.http.substr(0, colon);
+  server_options.port = port;
+  FleetMonitorOptions monitor_options;
+  monitor_options.domain_id = options.domain_id;
+  monitor_options.profiles_file = options.profiles_file;
+  if (!options.config_file.empty()) {
+    try {
+      const Config config = load_config(options.config_file);
+      server_options.vehicle = config.vehicle;
+      if (!options.domain_given) monitor_options.domain_id = config.dds.domain_id;
+      if (!options.profiles_given) {
+        monitor_options.profiles_file = config.dds.profiles_file;
+        monitor_options.participant_profile = config.dds.participant_profile;
+      }
+    } catch (const ConfigError& e) {
+      err << "pullout: " << e.what() << '\n';
+      return kExitBadInput;
+    }
+  }
+
+  std::optional<FleetMonitor> monitor;
+  std::optional<ViewServer> server;
+  try {
+    monitor.emplace(monitor_options);
+  } catch (const std::invalid_argument& e) {
+    err << "pullout: " << e.what() << '\n';
+    return kExitBadInput;
+  } catch (const FleetMonitorError& e) {
+    err << "pullout: DDS setup failed: " << e.what() << '\n';
+    return kExitCommunication;
+  }
+  try {
+    server.emplace(*monitor, server_options);
+  } catch (const std::runtime_error& e) {
+    err << "pullout: --http: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  out << "pullout view: http://" << server_options.address << ":" << server->port() << "/ (DDS domain "
+      << monitor_options.domain_id << ")" << std::endl;
+  const auto end =
+      options.duration_s > 0.0 ? SteadyClock::now() + seconds(options.duration_s) : SteadyClock::time_point::max();
+  while (!interrupted() && SteadyClock::now() < end) std::this_thread::sleep_for(kSlice);
+  server.reset();
   return kExitFound;
 }
 
