@@ -50,6 +50,25 @@ std::optional<PullOutStatus> SegmentDriver::drive_segment() {
   return st;
 }
 
+void SegmentDriver::keep_alive() {
+  const auto& points = path_.partial_paths[segment_].points;
+  stamp_ns_ += 100'000'000;
+  report(points.front().pose, points.front().longitudinal_velocity_mps < 0.0 ? -0.2 : 0.2);
+}
+
+KeepAlive::KeepAlive(SegmentDriver& driver)
+    : thread_([this, &driver] {
+        while (!stop_.load()) {
+          driver.keep_alive();
+          std::this_thread::sleep_for(100ms);
+        }
+      }) {}
+
+KeepAlive::~KeepAlive() {
+  stop_.store(true);
+  thread_.join();
+}
+
 std::vector<std::vector<std::string>> last_table_rows(const std::string& text) {
   std::vector<std::vector<std::string>> rows;
   std::istringstream lines(text);

@@ -3,8 +3,10 @@
 // against the statuses the vehicle itself received.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
+#include <thread>
 
 #include "integration_support.hpp"
 
@@ -25,6 +27,12 @@ class SegmentDriver {
   // vehicle is released on segment 0). Returns that status.
   std::optional<PullOutStatus> depart();
 
+  // One sample that keeps the service from stopping the vehicle for lost odometry
+  // (progress_timeout_s) while a test looks at the view: at the start of the current segment,
+  // 100 ms later on the vehicle's clock, moving slowly in the segment's direction (so the segment
+  // is not taken as finished).
+  void keep_alive();
+
   std::size_t segment() const { return segment_; }
 
  private:
@@ -35,6 +43,20 @@ class SegmentDriver {
   PullOutPath path_;
   std::size_t segment_{0};
   std::int64_t stamp_ns_{1'000'000'000};
+};
+
+// Calls driver.keep_alive() every 100 ms on a thread of its own while it exists. The driver must
+// not be used by another thread meanwhile.
+class KeepAlive {
+ public:
+  explicit KeepAlive(SegmentDriver& driver);
+  ~KeepAlive();
+  KeepAlive(const KeepAlive&) = delete;
+  KeepAlive& operator=(const KeepAlive&) = delete;
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
 };
 
 // The rows of a `pullout watch` table (the last one in `text`, whose tables are separated by blank

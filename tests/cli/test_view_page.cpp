@@ -171,16 +171,22 @@ TEST_F(ViewPage, DrawsTheVehicleAndFollowsItThroughItsSegments) {
     ASSERT_TRUE(st) << "the service did not move to segment " << k;
     ASSERT_EQ(st->current_path_idx, k);
     const std::string state = to_string(st->state);
-    look = wait_page([&](const nlohmann::json& j) {
-      return j["current"] == nlohmann::json::array({k}) && j["footprint_state"] == state;
-    });
+    {
+      const KeepAlive alive(driver);  // no stop for lost odometry while the page is read
+      look = wait_page([&](const nlohmann::json& j) {
+        return j["current"] == nlohmann::json::array({k}) && j["footprint_state"] == state;
+      });
+    }
     EXPECT_EQ(look["current"], nlohmann::json::array({k})) << look.dump();
     EXPECT_EQ(look["segments"], segment_count) << look.dump();
     EXPECT_EQ(look["footprint_state"], state) << look.dump();
     EXPECT_EQ(look["label"], std::string(kVehicle) + ": " + state + " " + std::to_string(k + 1) + "/3") << look.dump();
     EXPECT_NE(look["footprint"], start_footprint) << "the footprint did not follow the vehicle";
     EXPECT_TRUE(look["marker"]) << "the page was reloaded instead of updated";
-    shot("2_segment_" + std::to_string(k + 1));
+    {
+      const KeepAlive alive(driver);
+      shot("2_segment_" + std::to_string(k + 1));
+    }
   }
 }
 

@@ -2,6 +2,7 @@
 // loopback DDS. The table's rows are checked against the statuses the vehicles themselves
 // received: one vehicle released and driven into its second segment, one waiting for approval.
 #include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,7 +69,12 @@ TEST_F(Watch, ShowsEveryVehicleWithItsStateAndSegment) {
       waiting_id, [](const PullOutStatus& s) { return s.state == ExecutionState::kWaitingApproval; }, kReplyTimeout);
   ASSERT_TRUE(waiting_status);
 
-  const WatchRun run = run_watch({"--duration", "3", "--interval", "0.5"}, 20s);
+  std::optional<WatchRun> watched;
+  {
+    const KeepAlive alive(driver);  // executing stays executing while watched
+    watched = run_watch({"--duration", "3", "--interval", "0.5"}, 20s);
+  }
+  const WatchRun& run = *watched;
   EXPECT_TRUE(run.exit.clean()) << run.exit.describe();
   const auto rows = last_table_rows(run.out);
   ASSERT_EQ(rows.size(), 2u) << run.out;
@@ -81,6 +87,7 @@ TEST_F(Watch, ShowsEveryVehicleWithItsStateAndSegment) {
   ASSERT_GE(driven_row->size(), 6u) << run.out;
   const std::vector<std::string> driven_cells(driven_row->begin(), driven_row->begin() + 5);
   EXPECT_EQ(driven_cells, expected_row("watch-driven", *driven_status)) << run.out;
+  EXPECT_EQ(driven_cells[1], "executing");
   EXPECT_EQ(driven_cells[3], "2/3");
 
   const auto* waiting_row = row_of(rows, "watch-waiting");
