@@ -93,6 +93,8 @@ void install_interrupt_handlers() {
   std::signal(SIGTERM, handle_interrupt);
 }
 
+bool interrupted() { return g_interrupted.load(); }
+
 int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
   Config config;
   Scenario scenario;

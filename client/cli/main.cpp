@@ -3,6 +3,8 @@
 #include <iostream>
 #include <string>
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
@@ -20,6 +22,8 @@ constexpr const char* kExitCodes =
     "  3    communication failure or timeout (request: no service, no answer in time)\n"
     "  4    internal error\n"
     "  130  interrupted\n"
+    "view: 0 stopped, 2 bad option or address in use, 3 DDS setup failed\n"
+    "watch: 0 stopped (--duration, --once, interrupt), 3 DDS setup failed or --once found no service\n"
     "health: 0 the URL answered 200, 1 another HTTP status, 2 bad URL, 3 no answer (refused, timeout)\n";
 
 }  // namespace
@@ -76,6 +80,51 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   health_cmd->add_flag("-q,--quiet", health.quiet, "Print nothing on success");
 
+  pullout::cli::WatchOptions watch;
+  CLI::App* watch_cmd = app.add_subcommand(
+      "watch",
+      "Print a live table of every vehicle on the DDS domain (state, planner, segment i/n, safe, age of its latest "
+      "sample), read from the service's path and status topics and the vehicles' requests and progress as a passive "
+      "participant. On a terminal the table is redrawn in place; otherwise one table is printed per interval");
+  watch_cmd->add_option("--domain", watch.domain_id, "DDS domain id")->capture_default_str()->check(CLI::Range(0, 232));
+  watch_cmd
+      ->add_option("--profiles", watch.profiles_file, "Fast DDS XML profiles file (default: built-in, loopback only)")
+      ->check(CLI::ExistingFile);
+  watch_cmd->add_option("--interval", watch.interval_s, "Seconds between tables")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  CLI::Option* duration_opt =
+      watch_cmd->add_option("--duration", watch.duration_s, "Stop after this many seconds")->check(CLI::PositiveNumber);
+  watch_cmd
+      ->add_flag("--once", watch.once,
+                 "Print one table once the service's samples have arrived (at most --wait seconds), then exit")
+      ->excludes(duration_opt);
+  watch_cmd->add_option("--wait", watch.wait_s, "--once: seconds to wait for the service")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+
+  pullout::cli::ViewOptions view;
+  CLI::App* view_cmd = app.add_subcommand(
+      "view",
+      "Serve a web page that draws every vehicle on the DDS domain (lanes of its request, footprint, path with the "
+      "current segment highlighted, state), updated as samples arrive (Server-Sent Events). Listens on loopback "
+      "unless told otherwise");
+  view_cmd->add_option("--http", view.http, "ADDRESS:PORT to serve the page on (port 0: any free port)")
+      ->capture_default_str();
+  CLI::Option* view_domain =
+      view_cmd->add_option("--domain", view.domain_id, "DDS domain id (default: --config's dds.domain_id, else 0)")
+          ->check(CLI::Range(0, 232));
+  CLI::Option* view_profiles =
+      view_cmd
+          ->add_option("--profiles", view.profiles_file,
+                       "Fast DDS XML profiles file (default: --config's dds.profiles_file, else built-in loopback)")
+          ->check(CLI::ExistingFile);
+  view_cmd
+      ->add_option("--config", view.config_file,
+                   "pullout.yaml of the service: its vehicle is the footprint drawn, its dds section the defaults")
+      ->check(CLI::ExistingFile);
+  view_cmd->add_option("--duration", view.duration_s, "Stop after this many seconds")->check(CLI::PositiveNumber);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -87,6 +136,12 @@ int main(int argc, char** argv) {
     if (plan_cmd->parsed()) return pullout::cli::run_plan(plan, std::cout, std::cerr);
     if (health_cmd->parsed()) return pullout::cli::run_health(health, std::cout, std::cerr);
     pullout::cli::install_interrupt_handlers();
+    if (view_cmd->parsed()) {
+      view.domain_given = view_domain->count() > 0;
+      view.profiles_given = view_profiles->count() > 0;
+      return pullout::cli::run_view(view, std::cout, std::cerr);
+    }
+    if (watch_cmd->parsed()) return pullout::cli::run_watch(watch, isatty(STDOUT_FILENO) == 1, std::cout, std::cerr);
     return pullout::cli::run_request(request, std::cout, std::cerr);
   } catch (const std::exception& e) {
     std::cerr << "pullout: internal error: " << e.what() << '\n';
