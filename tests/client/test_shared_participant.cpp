@@ -256,22 +256,30 @@ TEST_F(SharedParticipantTest, VehiclesJoiningAndLeavingWhileOthersRequestEachGet
   std::atomic<bool> stop{false};
   std::atomic<int> answered{0};
   std::atomic<int> failures{0};
-  std::thread traffic([&] {
-    while (!stop.load()) {
-      for (auto& v : steady) {
-        PullOutRequest request = base_;
-        request.ego_pose.x = v.x;
-        const auto id = v.client->send(request);
-        const auto path = v.client->wait_for_path(id, kReplyTimeout);
-        if (!path || path->vehicle_id != v.client->vehicle_id() || path->request_id != id ||
-            std::abs(path->partial_paths.front().points.front().pose.x - v.x) > 1e-6) {
-          ++failures;
-        } else {
-          ++answered;
-        }
-      }
+  // Stopped and joined on every way out of the test (an ASSERT returns early).
+  struct Joiner {
+    std::atomic<bool>& stop;
+    std::thread thread;
+    ~Joiner() {
+      stop.store(true);
+      if (thread.joinable()) thread.join();
     }
-  });
+  } traffic{stop, std::thread([&] {
+              while (!stop.load()) {
+                for (auto& v : steady) {
+                  PullOutRequest request = base_;
+                  request.ego_pose.x = v.x;
+                  const auto id = v.client->send(request);
+                  const auto path = v.client->wait_for_path(id, kReplyTimeout);
+                  if (!path || path->vehicle_id != v.client->vehicle_id() || path->request_id != id ||
+                      std::abs(path->partial_paths.front().points.front().pose.x - v.x) > 1e-6) {
+                    ++failures;
+                  } else {
+                    ++answered;
+                  }
+                }
+              }
+            })};
 
   // Joiners 10..17, each served; every other one leaves again at once after its answer.
   std::vector<Vehicle> joined;
@@ -304,7 +312,7 @@ TEST_F(SharedParticipantTest, VehiclesJoiningAndLeavingWhileOthersRequestEachGet
   // The joined ones still served after the others left.
   for (auto& v : joined) expect_own_answer(v, send(v));
   stop.store(true);
-  traffic.join();
+  traffic.thread.join();
   EXPECT_EQ(failures.load(), 0);
   EXPECT_GE(answered.load(), kSteady);
   for (auto& v : steady) EXPECT_EQ(v.foreign->load(), 0) << v.client->vehicle_id();
