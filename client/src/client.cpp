@@ -333,6 +333,14 @@ class __attribute__((visibility("hidden"))) Client::Impl final : public client_d
   // resend window (give_up_locked may become true then with no sample arriving).
   SteadyClock::time_point recheck_locked(std::uint64_t request_id, SteadyClock::time_point deadline) const;
   bool stale_locked(const Received<PullOutStatus>& item) const;
+  // Own endpoints: answered by its path or a status past planning. Shared endpoints: by both,
+  // since a Client that just joined the set may get one of the two filtered out at the service
+  // (its path and status readers' new set reach the service's two writers one after the other);
+  // the re-send has the service publish both again.
+  void update_answered_locked() {
+    pending_.answered =
+        hub_ != nullptr ? pending_.path_seen && pending_.status_seen : pending_.path_seen || pending_.status_seen;
+  }
   template <typename T>
   void replace_callback(CallbackSlot<T>& slot, std::function<void(const T&)> callback);
   template <typename T>
@@ -387,7 +395,9 @@ class __attribute__((visibility("hidden"))) Client::Impl final : public client_d
     std::shared_ptr<const msg::PullOutRequest> sample;
     SteadyClock::time_point sent_at{};     // first write (send())
     SteadyClock::time_point last_write{};  // latest write
-    bool answered{false};
+    bool path_seen{false};                 // its path was received
+    bool status_seen{false};               // a status for it, past planning, was received
+    bool answered{false};                  // update_answered_locked
   } pending_;
   ServiceState service_state_{ServiceState::kNotFound};
   std::int32_t request_matches_{0};  // the request writer's current match count
@@ -1043,12 +1053,14 @@ std::uint64_t Client::Impl::send(PullOutRequest request) {
     std::lock_guard<std::mutex> lock(state_mutex_);
     const auto written = SteadyClock::now();
     // A reply that raced the write's return may already have answered it.
-    bool answered = false;
-    for (const auto& item : recent_paths_) answered = answered || item.value->request_id == id;
+    Pending pending{id, std::move(sample), written, written};
+    for (const auto& item : recent_paths_) pending.path_seen = pending.path_seen || item.value->request_id == id;
     for (const auto& item : recent_statuses_) {
-      answered = answered || (item.value->request_id == id && item.value->state != ExecutionState::kPlanning);
+      pending.status_seen =
+          pending.status_seen || (item.value->request_id == id && item.value->state != ExecutionState::kPlanning);
     }
-    pending_ = Pending{id, std::move(sample), written, written, answered};
+    pending_ = std::move(pending);
+    update_answered_locked();
   }
   wake_dispatcher();  // schedules the first re-send
   return id;
@@ -1343,17 +1355,18 @@ void Client::Impl::dispatch_once() {
     for (auto& path : paths) {
       // Before the first send(), follow the request the service last answered (restart case).
       if (!sent_any_) current_request_id_ = path->request_id;
-      if (path->request_id == pending_.id) pending_.answered = true;
+      if (path->request_id == pending_.id) pending_.path_seen = true;
       Received<PullOutPath> item{++path_seq_, std::move(path)};
       if (path_slot_.callback) path_out.push_back(item);
       push_bounded(recent_paths_, std::move(item), kRecentPaths);
     }
     for (auto& status : statuses) {
-      if (status->request_id == pending_.id && status->state != ExecutionState::kPlanning) pending_.answered = true;
+      if (status->request_id == pending_.id && status->state != ExecutionState::kPlanning) pending_.status_seen = true;
       Received<PullOutStatus> item{++status_seq_, std::move(status)};
       if (status_slot_.callback) status_out.push_back(item);
       push_bounded(recent_statuses_, std::move(item), kRecentStatuses);
     }
+    update_answered_locked();
   }
   if (!paths.empty() || !statuses.empty()) state_cv_.notify_all();
 

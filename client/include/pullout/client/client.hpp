@@ -78,6 +78,10 @@
 //     constructed together (in one go after the participant) get their vehicle's latest path and
 //     status as single-vehicle Clients do; a Client added later gets only the replies to its own
 //     requests;
+//   - a request is answered when both its path and a status past planning were received (not
+//     either): a Client that just joined the set can have one of the two filtered out at the
+//     service (the two readers' new set reaches the service's two writers one after the other),
+//     and the re-send has the service publish both again;
 //   - destroying a Client unregisters its request and progress instances (the service sees the
 //     vehicle go, as when a Client's own writers are deleted);
 //   - the set holds at most about 25 KB of ids (pullout/idl/vehicle_filter.hpp: about 2,300 ids
