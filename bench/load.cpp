@@ -2,14 +2,17 @@
 // pullout_service on loopback, bounded in time.
 //
 //   bench_load [--vehicles 1000] [--processes 4] [--rate 1] [--duration 30]
-//              [--participant-per-vehicle] [--no-netns] [--service PATH] [--config FILE]
+//              [--participant-per-vehicle | --endpoints-per-client] [--no-netns] [--service PATH]
+//              [--config FILE]
 //
 // On a DDS domain leased for the run: the real pullout_service (config/pullout.yaml with
 // config/dds/loopback.xml) and `processes` worker processes (this binary with --worker), each
-// with its share of the vehicles as pullout::Clients on one shared pullout::ClientParticipant
-// (--participant-per-vehicle: one participant per vehicle, the single-vehicle constructor, for
-// comparison). Once every client matched the service, each vehicle sends a straight_shoulder
-// request `rate` times a second for `duration` seconds, its start pose varied per vehicle and per
+// with its share of the vehicles as pullout::Clients on one shared pullout::ClientParticipant,
+// whose Clients share one request writer, one progress writer and one vehicle-set-filtered path
+// and status reader (--endpoints-per-client: each Client with endpoints of its own on the shared
+// participant, as before; --participant-per-vehicle: one participant per vehicle, the
+// single-vehicle constructor; both for comparison). Once every client matched the service, each vehicle sends a
+// straight_shoulder request `rate` times a second for `duration` seconds, its start pose varied per vehicle and per
 // request (x in [6, 30] m, y in [3.0, 3.4] m: real plans), the vehicles' phases spread evenly over
 // the period. A request is answered when its path and a status past planning have arrived
 // (latency = send() -> the later of the two, in the worker's callbacks); planned when that path is
@@ -133,6 +136,7 @@ struct WorkerArgs {
   double rate{1.0};
   double duration{10.0};
   bool participant_per_vehicle{false};
+  bool endpoints_per_client{false};
   std::string dir;
 };
 
@@ -143,6 +147,7 @@ int run_worker(const WorkerArgs& a) {
   if (!a.participant_per_vehicle) {
     pullout::ClientParticipantOptions po;
     po.domain_id = a.domain;
+    po.shared_endpoints = !a.endpoints_per_client;
     participant.emplace(po);
   }
   const auto t0 = SteadyClock::now();
@@ -373,6 +378,7 @@ struct Options {
   double rate{1.0};
   double duration{30.0};
   bool participant_per_vehicle{false};
+  bool endpoints_per_client{false};
   bool no_netns{false};
   bool inside{false};
   std::string service_exe{PULLOUT_SERVICE_EXE};
@@ -389,8 +395,11 @@ int run_coordinator(const Options& o) {
   const pid_t service_pid = service.pid();
   integration::TempDir dir;
   std::printf("bench_load: %d vehicles in %d processes (%s), %.2f Hz each, %.0f s; domain %d; load %s\n", o.vehicles,
-              o.processes, o.participant_per_vehicle ? "one participant per vehicle" : "shared participant", o.rate,
-              o.duration, service.domain(), load_text().c_str());
+              o.processes,
+              o.participant_per_vehicle ? "one participant per vehicle"
+              : o.endpoints_per_client  ? "shared participant, endpoints per client"
+                                        : "shared participant and endpoints",
+              o.rate, o.duration, service.domain(), load_text().c_str());
   std::fflush(stdout);
 
   std::vector<std::unique_ptr<integration::ChildProcess>> workers;
@@ -418,6 +427,7 @@ int run_coordinator(const Options& o) {
                                   "--duration", std::to_string(o.duration),
                                   "--dir",      dir.path()};
     if (o.participant_per_vehicle) argv.push_back("--participant-per-vehicle");
+    if (o.endpoints_per_client) argv.push_back("--endpoints-per-client");
     workers.push_back(
         std::make_unique<integration::ChildProcess>(argv, dir.path() + "/worker." + std::to_string(first) + ".out",
                                                     dir.path() + "/worker." + std::to_string(first) + ".err"));
@@ -572,9 +582,12 @@ int run_coordinator(const Options& o) {
       "[%%] | bytes/request |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::printf(
       "| %d | %d | %s | %.2f | %zu | %.1f | %.2f | %.2f | %.2f | %zu | %d | %zu | %.0f | %.1f | %.0f | %.0f | %s |\n",
-      o.vehicles, o.processes, o.participant_per_vehicle ? "1 per vehicle" : "1 per process", o.rate, sent,
-      static_cast<double>(latencies.size()) / o.duration, s.p50, s.p99, s.max, lost, mismatched, not_planned,
-      service_cpu, hwm_mb, workers_cpu, machine_busy, bytes_text.c_str());
+      o.vehicles, o.processes,
+      o.participant_per_vehicle ? "1 per vehicle"
+      : o.endpoints_per_client  ? "1 per process, endpoints per client"
+                                : "1 per process, shared endpoints",
+      o.rate, sent, static_cast<double>(latencies.size()) / o.duration, s.p50, s.p99, s.max, lost, mismatched,
+      not_planned, service_cpu, hwm_mb, workers_cpu, machine_busy, bytes_text.c_str());
 
   for (auto& w : workers) {
     if (w->running()) ::kill(w->pid(), SIGTERM);
@@ -640,6 +653,8 @@ int main(int argc, char** argv) {
   app.add_option("--rate", o.rate, "requests per second per vehicle")->check(CLI::Range(0.01, 100.0));
   app.add_option("--duration", o.duration, "seconds of sending")->check(CLI::Range(1.0, 150.0));
   app.add_flag("--participant-per-vehicle", o.participant_per_vehicle, "one DDS participant per vehicle");
+  app.add_flag("--endpoints-per-client", o.endpoints_per_client,
+               "each client with endpoints of its own on the shared participant (as before)");
   app.add_flag("--no-netns", o.no_netns, "do not use a network namespace (no byte count)");
   app.add_option("--service", o.service_exe, "the pullout_service binary");
   app.add_option("--config", o.config_path, "the service's config");
@@ -656,6 +671,7 @@ int main(int argc, char** argv) {
       w.rate = o.rate;
       w.duration = o.duration;
       w.participant_per_vehicle = o.participant_per_vehicle;
+      w.endpoints_per_client = o.endpoints_per_client;
       return run_worker(w);
     }
     if (o.processes > o.vehicles) throw std::runtime_error("--processes exceeds --vehicles");

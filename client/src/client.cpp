@@ -11,6 +11,7 @@
 #include <mutex>
 #include <set>
 #include <thread>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -56,6 +57,8 @@ constexpr int kPathReaderDepth = 4;
 constexpr int kStatusReaderDepth = 8;
 // The client's thread wakes at least this often (a missed wake-up, the matched counts).
 constexpr auto kDispatchPeriod = std::chrono::milliseconds(1000);
+// Instances the shared endpoints of a ClientParticipant hold at least (one per vehicle on it).
+constexpr std::int32_t kSharedMaxInstances = 4096;
 
 std::int64_t system_now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -121,13 +124,39 @@ void push_bounded(std::deque<Received<T>>& queue, Received<T> item, std::size_t 
 
 namespace client_detail {
 
+// What a ClientParticipant's shared endpoints hand to one Client (Client::Impl implements it).
+// Called on the Hub's thread with no Hub lock but its routes lock held: keep it short.
+class __attribute__((visibility("hidden"))) VehicleSink {
+ public:
+  virtual void push_path(std::shared_ptr<const PullOutPath> path) = 0;
+  virtual void push_status(std::shared_ptr<const PullOutStatus> status) = 0;
+  // The service's matches or the applied filter changed: look again.
+  virtual void wake() = 0;
+
+ protected:
+  ~VehicleSink() = default;
+};
+
+// The shared endpoints' matches with the service.
+struct Matches {
+  std::int32_t request{0};
+  std::int32_t progress{0};
+  std::int32_t path{0};
+  std::int32_t status{0};
+  std::uint64_t request_epoch{0};  // incremented whenever the request writer matched a new reader
+};
+
+class Hub;
+
 // The DDS participant, its topics and the vehicle filter factory, shared by the Clients on it: one
 // per single-vehicle Client, or one per ClientParticipant. Each Client holds a shared_ptr, so the
 // participant is deleted after the last Client on it.
 class __attribute__((visibility("hidden"))) SharedParticipant {
  public:
+  // shared_endpoints: create the Hub (a ClientParticipant's one request writer, progress writer,
+  // path and status readers for all its Clients).
   SharedParticipant(int domain_id, std::string profiles_file, const std::string& participant_profile,
-                    const std::string& security_dir);
+                    const std::string& security_dir, bool shared_endpoints = false);
   ~SharedParticipant();
   SharedParticipant(const SharedParticipant&) = delete;
   SharedParticipant& operator=(const SharedParticipant&) = delete;
@@ -139,6 +168,8 @@ class __attribute__((visibility("hidden"))) SharedParticipant {
   dds::Topic* progress_topic() const { return progress_topic_; }
   dds::Topic* path_topic() const { return path_topic_; }
   dds::Topic* status_topic() const { return status_topic_; }
+  // The shared endpoints; null when each Client has its own.
+  Hub* hub() const { return hub_.get(); }
 
   // Registers a Client for vehicle_id; throws std::invalid_argument when one is already alive.
   // Returns a serial that makes the Client's content-filtered topic names unique.
@@ -152,7 +183,7 @@ class __attribute__((visibility("hidden"))) SharedParticipant {
   const int domain_id_;
   const std::string profiles_file_;
   // Registered with the participant: declared first (destroyed last).
-  void create(const std::string& participant_profile, const std::string& security_dir);
+  void create(const std::string& participant_profile, const std::string& security_dir, bool shared_endpoints);
   void destroy() noexcept;
 
   idl::VehicleIdFilterFactory filter_factory_;
@@ -161,16 +192,99 @@ class __attribute__((visibility("hidden"))) SharedParticipant {
   dds::Topic* progress_topic_{nullptr};
   dds::Topic* path_topic_{nullptr};
   dds::Topic* status_topic_{nullptr};
+  std::unique_ptr<Hub> hub_;
   mutable std::mutex mutex_;
   std::set<std::string> vehicles_;
   std::uint64_t next_serial_{0};
   std::mutex entities_mutex_;
 };
 
+// A ClientParticipant's shared endpoints: one request and one progress writer (each Client writes
+// its own instance, keyed by its vehicle id) and one path and one status reader whose content
+// filter is the set of the participant's vehicles (idl::kVehicleSetFilterExpression), filtered at
+// the service's writers. Its thread takes every reply and hands it to the Client of its vehicle
+// (VehicleSink), and tracks the matches with the service. So the service's writers see one
+// filtered reader per participant, not one per vehicle (bench/RESULTS.md, "Load").
+//
+// Membership: add() puts a vehicle in the set; the thread applies the set to both readers'
+// filters (ContentFilteredTopic::set_expression_parameters: the readers are announced again and
+// the service's writers update their filters in place), coalescing changes that come within
+// kApplyInterval. A vehicle counts as connected only once its id is in the applied set
+// (is_applied). A reply the service writes before it has the new set is filtered out there; the
+// Client's re-send repairs that.
+class __attribute__((visibility("hidden"))) Hub {
+ public:
+  static constexpr auto kApplyInterval = std::chrono::milliseconds(20);
+
+  Hub(dds::DomainParticipant* participant, dds::Topic* request_topic, dds::Topic* progress_topic,
+      dds::Topic* path_topic, dds::Topic* status_topic, const std::string& profiles_file);
+  ~Hub();
+  Hub(const Hub&) = delete;
+  Hub& operator=(const Hub&) = delete;
+
+  // Routes vehicle_id's replies to sink. False (nothing changed) when the set filter has no room
+  // for it (idl::kVehicleSetCapacityBytes).
+  bool add(const std::string& vehicle_id, VehicleSink* sink);
+  // Stops routing to the vehicle's sink (no push after this returns), takes it out of the set,
+  // and unregisters its request and progress instances (the service sees them disposed).
+  void remove(const std::string& vehicle_id, bool wrote_request, bool wrote_progress);
+  bool is_applied(const std::string& vehicle_id) const;
+  Matches matches() const;
+  bool write_request(msg::PullOutRequest* sample);
+  bool write_progress(msg::ExecutionProgress* sample);
+  std::size_t members() const;
+
+ private:
+  void create();
+  void create_readers(const std::vector<std::string>& parameters);
+  void destroy() noexcept;
+  void run();
+  void apply_set();
+  void take_and_route();
+  bool update_matches();
+
+  dds::DomainParticipant* const participant_;
+  dds::Topic* const request_topic_;
+  dds::Topic* const progress_topic_;
+  dds::Topic* const path_topic_;
+  dds::Topic* const status_topic_;
+  const std::string profiles_file_;
+  dds::Publisher* publisher_{nullptr};
+  dds::Subscriber* subscriber_{nullptr};
+  dds::DataWriter* request_writer_{nullptr};
+  dds::DataWriter* progress_writer_{nullptr};
+  dds::ContentFilteredTopic* path_filter_{nullptr};
+  dds::ContentFilteredTopic* status_filter_{nullptr};
+  dds::DataReader* path_reader_{nullptr};
+  dds::DataReader* status_reader_{nullptr};
+
+  // The set: members_ as wanted, applied_ as the readers' filters have it. Guarded by set_mutex_.
+  mutable std::mutex set_mutex_;
+  std::set<std::string> members_;
+  std::set<std::string> applied_;
+  std::size_t encoded_bytes_{0};
+  bool dirty_{false};
+  std::chrono::steady_clock::time_point last_change_{};  // of members_
+
+  mutable std::mutex routes_mutex_;
+  std::unordered_map<std::string, VehicleSink*> routes_;
+
+  mutable std::mutex matches_mutex_;
+  Matches matches_;
+
+  // The generated type support keeps per-type scratch buffers: one write per writer at a time.
+  std::mutex request_write_mutex_;
+  std::mutex progress_write_mutex_;
+
+  dds::GuardCondition wake_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
 }  // namespace client_detail
 
 // Hidden explicitly: a nested class inherits the default visibility of the exported Client.
-class __attribute__((visibility("hidden"))) Client::Impl {
+class __attribute__((visibility("hidden"))) Client::Impl final : public client_detail::VehicleSink {
  public:
   // shared: the participant to create the client's endpoints on; null: a participant of its own.
   Impl(std::shared_ptr<client_detail::SharedParticipant> shared, ClientOptions options);
@@ -191,6 +305,11 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   ServiceState service_state() const;
 
   const ClientOptions& options() const { return options_; }
+
+  // VehicleSink (shared endpoints): on the Hub's thread.
+  void push_path(std::shared_ptr<const PullOutPath> path) override;
+  void push_status(std::shared_ptr<const PullOutStatus> status) override;
+  void wake() override { wake_dispatcher(); }
 
  private:
   void create_entities();
@@ -214,12 +333,21 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   // resend window (give_up_locked may become true then with no sample arriving).
   SteadyClock::time_point recheck_locked(std::uint64_t request_id, SteadyClock::time_point deadline) const;
   bool stale_locked(const Received<PullOutStatus>& item) const;
+  // Own endpoints: answered by its path or a status past planning. Shared endpoints: by both,
+  // since a Client that just joined the set may get one of the two filtered out at the service
+  // (its path and status readers' new set reach the service's two writers one after the other);
+  // the re-send has the service publish both again.
+  void update_answered_locked() {
+    pending_.answered =
+        hub_ != nullptr ? pending_.path_seen && pending_.status_seen : pending_.path_seen || pending_.status_seen;
+  }
   template <typename T>
   void replace_callback(CallbackSlot<T>& slot, std::function<void(const T&)> callback);
   template <typename T>
   bool deliver(CallbackSlot<T>& slot, const Received<T>& item, std::uint64_t generation, const char* what);
   std::vector<std::shared_ptr<const PullOutPath>> take_paths();
   std::vector<std::shared_ptr<const PullOutStatus>> take_statuses();
+  bool write_request(msg::PullOutRequest* sample);
   bool on_dispatcher_thread() const { return std::this_thread::get_id() == dispatcher_.get_id(); }
   void wake_dispatcher() { wake_.set_trigger_value(true); }
 
@@ -239,6 +367,17 @@ class __attribute__((visibility("hidden"))) Client::Impl {
   dds::DataWriter* progress_writer_{nullptr};
   dds::DataReader* path_reader_{nullptr};
   dds::DataReader* status_reader_{nullptr};
+  // The participant's shared endpoints carry this client (instead of the endpoints above); null
+  // when it has its own.
+  client_detail::Hub* hub_{nullptr};
+  std::atomic<bool> wrote_request_{false};
+  std::atomic<bool> wrote_progress_{false};
+  std::uint64_t request_epoch_{0};  // the Hub's request_epoch last seen (dispatcher thread only)
+
+  // Replies the Hub handed over, not yet taken by the client's thread.
+  std::mutex inbox_mutex_;
+  std::vector<std::shared_ptr<const PullOutPath>> inbox_paths_;
+  std::vector<std::shared_ptr<const PullOutStatus>> inbox_statuses_;
 
   // --- received state, guarded by state_mutex_ ---
   mutable std::mutex state_mutex_;
@@ -256,7 +395,9 @@ class __attribute__((visibility("hidden"))) Client::Impl {
     std::shared_ptr<const msg::PullOutRequest> sample;
     SteadyClock::time_point sent_at{};     // first write (send())
     SteadyClock::time_point last_write{};  // latest write
-    bool answered{false};
+    bool path_seen{false};                 // its path was received
+    bool status_seen{false};               // a status for it, past planning, was received
+    bool answered{false};                  // update_answered_locked
   } pending_;
   ServiceState service_state_{ServiceState::kNotFound};
   std::int32_t request_matches_{0};  // the request writer's current match count
@@ -285,10 +426,10 @@ class __attribute__((visibility("hidden"))) Client::Impl {
 namespace client_detail {
 
 SharedParticipant::SharedParticipant(int domain_id, std::string profiles_file, const std::string& participant_profile,
-                                     const std::string& security_dir)
+                                     const std::string& security_dir, bool shared_endpoints)
     : domain_id_(domain_id), profiles_file_(std::move(profiles_file)) {
   try {
-    create(participant_profile, security_dir);
+    create(participant_profile, security_dir, shared_endpoints);
   } catch (...) {
     destroy();
     throw;
@@ -298,13 +439,15 @@ SharedParticipant::SharedParticipant(int domain_id, std::string profiles_file, c
 SharedParticipant::~SharedParticipant() { destroy(); }
 
 void SharedParticipant::destroy() noexcept {
+  hub_.reset();
   if (participant_ == nullptr) return;
   participant_->delete_contained_entities();
   dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
   participant_ = nullptr;
 }
 
-void SharedParticipant::create(const std::string& participant_profile, const std::string& security_dir) {
+void SharedParticipant::create(const std::string& participant_profile, const std::string& security_dir,
+                               bool shared_endpoints) {
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::DomainParticipantQos participant_qos;
   if (profiles_file_.empty()) {
@@ -365,6 +508,10 @@ void SharedParticipant::create(const std::string& participant_profile, const std
       create_topic(client_detail::kPathTopic, register_type(idl::make_guarded_type<msg::PullOutPathPubSubType>()));
   status_topic_ =
       create_topic(client_detail::kStatusTopic, register_type(idl::make_guarded_type<msg::PullOutStatusPubSubType>()));
+  if (shared_endpoints) {
+    hub_ = std::make_unique<Hub>(participant_, request_topic_, progress_topic_, path_topic_, status_topic_,
+                                 profiles_file_);
+  }
 }
 
 std::uint64_t SharedParticipant::claim(const std::string& vehicle_id) {
@@ -384,6 +531,341 @@ void SharedParticipant::release(const std::string& vehicle_id) {
 std::size_t SharedParticipant::client_count() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return vehicles_.size();
+}
+
+// ------------------------------------------------------------------------------------------------
+// The shared endpoints of a ClientParticipant
+
+Hub::Hub(dds::DomainParticipant* participant, dds::Topic* request_topic, dds::Topic* progress_topic,
+         dds::Topic* path_topic, dds::Topic* status_topic, const std::string& profiles_file)
+    : participant_(participant),
+      request_topic_(request_topic),
+      progress_topic_(progress_topic),
+      path_topic_(path_topic),
+      status_topic_(status_topic),
+      profiles_file_(profiles_file) {
+  try {
+    create();
+    thread_ = std::thread([this] { run(); });
+  } catch (...) {
+    destroy();
+    throw;
+  }
+}
+
+Hub::~Hub() {
+  stop_.store(true);
+  wake_.set_trigger_value(true);
+  if (thread_.joinable()) thread_.join();
+  destroy();
+}
+
+void Hub::create() {
+  publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (publisher_ == nullptr || subscriber_ == nullptr) throw ClientError("cannot create a DDS publisher/subscriber");
+  // The QoS of the per-Client endpoints (profile, else built in), with room for every vehicle's
+  // instance: Fast DDS's default max_instances is 10.
+  const auto writer_qos = [&](const char* profile) {
+    dds::DataWriterQos qos = command_writer_qos();
+    if (!profiles_file_.empty()) {
+      dds::DataWriterQos from_profile;
+      if (publisher_->get_datawriter_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
+        qos = from_profile;
+      }
+    }
+    auto& limits = qos.resource_limits();
+    if (limits.max_instances > 0 && limits.max_instances < kSharedMaxInstances) {
+      const int depth = std::max(1, qos.history().depth);
+      limits.max_instances = kSharedMaxInstances;
+      limits.max_samples_per_instance = depth;
+      limits.max_samples = kSharedMaxInstances * depth;
+    }
+    return qos;
+  };
+  request_writer_ = publisher_->create_datawriter(request_topic_, writer_qos(kRequestWriterProfile));
+  if (request_writer_ == nullptr) throw ClientError("cannot create the shared pullout/request writer");
+  progress_writer_ = publisher_->create_datawriter(progress_topic_, writer_qos(kProgressWriterProfile));
+  if (progress_writer_ == nullptr) throw ClientError("cannot create the shared pullout/progress writer");
+  request_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
+  progress_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
+}
+
+// The readers are created with the first set, once Clients stopped coming for kApplyInterval: the
+// service's transient-local history (each vehicle's latest path and status) reaches a reader when
+// it matches, filtered by the set it has then, so the Clients constructed together with the
+// participant get their vehicle's latest path and status as single-vehicle Clients do.
+void Hub::create_readers(const std::vector<std::string>& parameters) {
+  const auto reader_qos = [&](const char* profile, int depth) {
+    dds::DataReaderQos qos = reply_reader_qos(depth);
+    if (!profiles_file_.empty()) {
+      dds::DataReaderQos from_profile;
+      if (subscriber_->get_datareader_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
+        qos = from_profile;
+      }
+    }
+    auto& limits = qos.resource_limits();
+    if (limits.max_instances > 0 && limits.max_instances < kSharedMaxInstances) {
+      const int depth = std::max(1, qos.history().depth);
+      limits.max_instances = kSharedMaxInstances;
+      limits.max_samples_per_instance = depth;
+      limits.max_samples = kSharedMaxInstances * depth;
+    }
+    return qos;
+  };
+  const auto filtered_reader = [&](dds::Topic* topic, const char* profile, int depth,
+                                   dds::ContentFilteredTopic** filter) {
+    const std::string name = topic->get_name();
+    *filter = participant_->create_contentfilteredtopic(name + "/vehicles", topic, idl::kVehicleSetFilterExpression,
+                                                        parameters, idl::kVehicleFilterClass);
+    if (*filter == nullptr) throw ClientError("cannot create the vehicle set filter on " + name);
+    dds::DataReader* reader = subscriber_->create_datareader(*filter, reader_qos(profile, depth));
+    if (reader == nullptr) throw ClientError("cannot create the shared " + name + " reader");
+    reader->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
+                                                       << dds::StatusMask::subscription_matched());
+    return reader;
+  };
+  path_reader_ = filtered_reader(path_topic_, kPathReaderProfile, kPathReaderDepth, &path_filter_);
+  status_reader_ = filtered_reader(status_topic_, kStatusReaderProfile, kStatusReaderDepth, &status_filter_);
+}
+
+void Hub::destroy() noexcept {
+  if (subscriber_ != nullptr) {
+    if (path_reader_ != nullptr) subscriber_->delete_datareader(path_reader_);
+    if (status_reader_ != nullptr) subscriber_->delete_datareader(status_reader_);
+    participant_->delete_subscriber(subscriber_);
+  }
+  if (path_filter_ != nullptr) participant_->delete_contentfilteredtopic(path_filter_);
+  if (status_filter_ != nullptr) participant_->delete_contentfilteredtopic(status_filter_);
+  if (publisher_ != nullptr) {
+    if (request_writer_ != nullptr) publisher_->delete_datawriter(request_writer_);
+    if (progress_writer_ != nullptr) publisher_->delete_datawriter(progress_writer_);
+    participant_->delete_publisher(publisher_);
+  }
+  subscriber_ = nullptr;
+  publisher_ = nullptr;
+  path_reader_ = status_reader_ = nullptr;
+  path_filter_ = status_filter_ = nullptr;
+  request_writer_ = progress_writer_ = nullptr;
+}
+
+bool Hub::add(const std::string& vehicle_id, VehicleSink* sink) {
+  {
+    std::lock_guard<std::mutex> lock(set_mutex_);
+    const std::size_t bytes = idl::vehicle_set_entry_bytes(vehicle_id);
+    if (encoded_bytes_ + bytes > idl::kVehicleSetCapacityBytes) return false;
+    // SharedParticipant::claim already refused a second Client of this vehicle.
+    members_.insert(vehicle_id);
+    encoded_bytes_ += bytes;
+    dirty_ = true;
+    last_change_ = SteadyClock::now();
+  }
+  {
+    std::lock_guard<std::mutex> lock(routes_mutex_);
+    routes_[vehicle_id] = sink;
+  }
+  wake_.set_trigger_value(true);
+  return true;
+}
+
+void Hub::remove(const std::string& vehicle_id, bool wrote_request, bool wrote_progress) {
+  {
+    std::lock_guard<std::mutex> lock(routes_mutex_);
+    routes_.erase(vehicle_id);
+  }
+  {
+    std::lock_guard<std::mutex> lock(set_mutex_);
+    if (members_.erase(vehicle_id) != 0) encoded_bytes_ -= idl::vehicle_set_entry_bytes(vehicle_id);
+    dirty_ = true;
+    last_change_ = SteadyClock::now();
+  }
+  wake_.set_trigger_value(true);
+  // As a Client's own writers being deleted: the service sees the vehicle's instances go (with
+  // the writers' default autodispose_unregistered_instances, disposed) and may evict it.
+  if (wrote_request) {
+    msg::PullOutRequest key;
+    key.vehicle_id(vehicle_id);
+    std::lock_guard<std::mutex> lock(request_write_mutex_);
+    request_writer_->unregister_instance(&key, dds::HANDLE_NIL);
+  }
+  if (wrote_progress) {
+    msg::ExecutionProgress key;
+    key.vehicle_id(vehicle_id);
+    std::lock_guard<std::mutex> lock(progress_write_mutex_);
+    progress_writer_->unregister_instance(&key, dds::HANDLE_NIL);
+  }
+}
+
+bool Hub::is_applied(const std::string& vehicle_id) const {
+  std::lock_guard<std::mutex> lock(set_mutex_);
+  return applied_.count(vehicle_id) != 0;
+}
+
+Matches Hub::matches() const {
+  std::lock_guard<std::mutex> lock(matches_mutex_);
+  return matches_;
+}
+
+std::size_t Hub::members() const {
+  std::lock_guard<std::mutex> lock(set_mutex_);
+  return members_.size();
+}
+
+bool Hub::write_request(msg::PullOutRequest* sample) {
+  std::lock_guard<std::mutex> lock(request_write_mutex_);
+  return request_writer_->write(sample);
+}
+
+bool Hub::write_progress(msg::ExecutionProgress* sample) {
+  std::lock_guard<std::mutex> lock(progress_write_mutex_);
+  return progress_writer_->write(sample);
+}
+
+void Hub::run() {
+  dds::WaitSet waitset;
+  waitset.attach_condition(request_writer_->get_statuscondition());
+  waitset.attach_condition(progress_writer_->get_statuscondition());
+  waitset.attach_condition(wake_);
+  dds::ConditionSeq active;
+  SteadyClock::time_point last_apply{};
+  while (!stop_.load()) {
+    auto wait = std::chrono::duration_cast<std::chrono::nanoseconds>(kDispatchPeriod);
+    bool dirty = false;
+    SteadyClock::time_point last_change{};
+    {
+      std::lock_guard<std::mutex> lock(set_mutex_);
+      dirty = dirty_;
+      last_change = last_change_;
+    }
+    if (dirty) {
+      // The first set once Clients stopped coming (create_readers), later ones at most every
+      // kApplyInterval.
+      const auto due = path_reader_ == nullptr ? last_change + kApplyInterval : last_apply + kApplyInterval;
+      const auto now = SteadyClock::now();
+      if (due <= now) {
+        const bool first = path_reader_ == nullptr;
+        apply_set();
+        last_apply = now;
+        if (first && path_reader_ != nullptr) {
+          waitset.attach_condition(path_reader_->get_statuscondition());
+          waitset.attach_condition(status_reader_->get_statuscondition());
+        }
+      } else {
+        wait = std::chrono::duration_cast<std::chrono::nanoseconds>(due - now);
+      }
+    }
+    take_and_route();
+    if (update_matches()) {
+      std::lock_guard<std::mutex> lock(routes_mutex_);
+      for (const auto& [id, sink] : routes_) sink->wake();
+    }
+    waitset.wait(active, eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(wait.count() / 1000000000),
+                                                        static_cast<std::uint32_t>(wait.count() % 1000000000)));
+    wake_.set_trigger_value(false);
+  }
+  waitset.detach_condition(wake_);
+  waitset.detach_condition(progress_writer_->get_statuscondition());
+  waitset.detach_condition(request_writer_->get_statuscondition());
+  if (path_reader_ != nullptr) {
+    waitset.detach_condition(status_reader_->get_statuscondition());
+    waitset.detach_condition(path_reader_->get_statuscondition());
+  }
+}
+
+void Hub::apply_set() {
+  std::vector<std::string> ids;
+  {
+    std::lock_guard<std::mutex> lock(set_mutex_);
+    ids.assign(members_.begin(), members_.end());
+    dirty_ = false;
+  }
+  const std::vector<std::string> parameters = idl::encode_vehicle_set(ids);
+  bool path_ok = false;
+  bool status_ok = false;
+  if (path_reader_ == nullptr) {
+    try {
+      create_readers(parameters);
+      path_ok = status_ok = true;
+    } catch (const ClientError& e) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, e.what());
+      // Whatever was created goes; the next round tries again.
+      if (path_reader_ != nullptr) subscriber_->delete_datareader(path_reader_);
+      if (status_reader_ != nullptr) subscriber_->delete_datareader(status_reader_);
+      if (path_filter_ != nullptr) participant_->delete_contentfilteredtopic(path_filter_);
+      if (status_filter_ != nullptr) participant_->delete_contentfilteredtopic(status_filter_);
+      path_reader_ = status_reader_ = nullptr;
+      path_filter_ = status_filter_ = nullptr;
+    }
+  } else {
+    path_ok = path_filter_->set_expression_parameters(parameters) == ReturnCode::RETCODE_OK;
+    status_ok = status_filter_->set_expression_parameters(parameters) == ReturnCode::RETCODE_OK;
+  }
+  if (!path_ok || !status_ok) {
+    // Cannot happen within kVehicleSetCapacityBytes; try again at the next round.
+    EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "cannot set the vehicle set filter of " << ids.size() << " vehicles");
+    std::lock_guard<std::mutex> lock(set_mutex_);
+    dirty_ = true;
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(set_mutex_);
+    applied_ = std::set<std::string>(ids.begin(), ids.end());
+  }
+  std::lock_guard<std::mutex> lock(routes_mutex_);
+  for (const auto& [id, sink] : routes_) sink->wake();
+}
+
+void Hub::take_and_route() {
+  if (path_reader_ == nullptr) return;
+  const auto route = [this](const std::string& vehicle_id, auto&& push) {
+    std::lock_guard<std::mutex> lock(routes_mutex_);
+    auto it = routes_.find(vehicle_id);
+    if (it != routes_.end()) push(it->second);
+  };
+  msg::PullOutPath path_sample;
+  dds::SampleInfo info;
+  while (path_reader_->take_next_sample(&path_sample, &info) == ReturnCode::RETCODE_OK) {
+    if (!info.valid_data) continue;  // instance disposed / writer gone: nothing to deliver
+    try {
+      auto path = std::make_shared<const PullOutPath>(idl::from_msg(path_sample));
+      route(path->vehicle_id, [&](VehicleSink* sink) { sink->push_path(path); });
+    } catch (const std::exception& e) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "dropped a path sample that could not be converted: " << e.what());
+    }
+  }
+  msg::PullOutStatus status_sample;
+  while (status_reader_->take_next_sample(&status_sample, &info) == ReturnCode::RETCODE_OK) {
+    if (!info.valid_data) continue;
+    try {
+      auto status = std::make_shared<const PullOutStatus>(idl::from_msg(status_sample));
+      route(status->vehicle_id, [&](VehicleSink* sink) { sink->push_status(status); });
+    } catch (const std::exception& e) {
+      EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "dropped a status sample that could not be converted: " << e.what());
+    }
+  }
+}
+
+bool Hub::update_matches() {
+  dds::PublicationMatchedStatus request_matched;
+  dds::PublicationMatchedStatus progress_matched;
+  dds::SubscriptionMatchedStatus path_matched;
+  dds::SubscriptionMatchedStatus status_matched;
+  // This thread alone reads them (reading resets the change counts and the wait set trigger).
+  request_writer_->get_publication_matched_status(request_matched);
+  progress_writer_->get_publication_matched_status(progress_matched);
+  if (path_reader_ != nullptr) {
+    path_reader_->get_subscription_matched_status(path_matched);
+    status_reader_->get_subscription_matched_status(status_matched);
+  }
+  std::lock_guard<std::mutex> lock(matches_mutex_);
+  const Matches before = matches_;
+  matches_.request = request_matched.current_count;
+  matches_.progress = progress_matched.current_count;
+  matches_.path = path_matched.current_count;
+  matches_.status = status_matched.current_count;
+  if (request_matched.total_count_change > 0) ++matches_.request_epoch;
+  return before.request != matches_.request || before.progress != matches_.progress || before.path != matches_.path ||
+         before.status != matches_.status || before.request_epoch != matches_.request_epoch;
 }
 
 }  // namespace client_detail
@@ -430,6 +912,12 @@ Client::Impl::~Impl() {
 }
 
 void Client::Impl::create_entities() {
+  // On a ClientParticipant's shared endpoints when its set filter has room; else endpoints of its
+  // own (as a single-vehicle Client).
+  if (client_detail::Hub* hub = shared_->hub(); hub != nullptr && hub->add(options_.vehicle_id, this)) {
+    hub_ = hub;
+    return;
+  }
   std::lock_guard<std::mutex> lock(shared_->entities_mutex());
   const bool secure = !options_.security_dir.empty();
   dds::Topic* request_topic = shared_->request_topic();
@@ -501,6 +989,10 @@ dds::DataReaderQos Client::Impl::reader_qos(const char* profile, int depth) cons
 
 void Client::Impl::destroy_entities() noexcept {
   if (!shared_) return;
+  if (hub_ != nullptr) {
+    hub_->remove(options_.vehicle_id, wrote_request_.load(), wrote_progress_.load());
+    hub_ = nullptr;
+  }
   {
     // Only this client's entities: the other clients on the participant keep theirs. Readers
     // before their content-filtered topics.
@@ -551,7 +1043,7 @@ std::uint64_t Client::Impl::send(PullOutRequest request) {
   request.request_id = id;
   request.stamp_ns = now;
   auto sample = std::make_shared<msg::PullOutRequest>(idl::to_msg(request));
-  if (!request_writer_->write(sample.get())) {
+  if (!write_request(sample.get())) {
     std::lock_guard<std::mutex> lock(state_mutex_);
     if (current_request_id_ == id) current_request_id_ = previous;
     throw ClientError("cannot write request " + std::to_string(id) +
@@ -561,12 +1053,14 @@ std::uint64_t Client::Impl::send(PullOutRequest request) {
     std::lock_guard<std::mutex> lock(state_mutex_);
     const auto written = SteadyClock::now();
     // A reply that raced the write's return may already have answered it.
-    bool answered = false;
-    for (const auto& item : recent_paths_) answered = answered || item.value->request_id == id;
+    Pending pending{id, std::move(sample), written, written};
+    for (const auto& item : recent_paths_) pending.path_seen = pending.path_seen || item.value->request_id == id;
     for (const auto& item : recent_statuses_) {
-      answered = answered || (item.value->request_id == id && item.value->state != ExecutionState::kPlanning);
+      pending.status_seen =
+          pending.status_seen || (item.value->request_id == id && item.value->state != ExecutionState::kPlanning);
     }
-    pending_ = Pending{id, std::move(sample), written, written, answered};
+    pending_ = std::move(pending);
+    update_answered_locked();
   }
   wake_dispatcher();  // schedules the first re-send
   return id;
@@ -583,7 +1077,7 @@ void Client::Impl::resend_pending(std::uint64_t id) {
     pending_.last_write = SteadyClock::now();
   }
   // write() takes a non-const pointer but does not modify the sample.
-  if (!request_writer_->write(const_cast<msg::PullOutRequest*>(sample.get()))) {
+  if (!write_request(const_cast<msg::PullOutRequest*>(sample.get()))) {
     EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, "re-sending request " << id << " failed (DDS write)");
   }
 }
@@ -608,17 +1102,31 @@ bool Client::Impl::stale_locked(const Received<PullOutStatus>& item) const {
 }
 
 SteadyClock::time_point Client::Impl::update_service_and_resend() {
-  dds::PublicationMatchedStatus request_matched;
-  dds::PublicationMatchedStatus progress_matched;
-  dds::SubscriptionMatchedStatus path_matched;
-  dds::SubscriptionMatchedStatus status_matched;
-  // Reading a status also resets its trigger in the wait set.
-  request_writer_->get_publication_matched_status(request_matched);
-  progress_writer_->get_publication_matched_status(progress_matched);
-  path_reader_->get_subscription_matched_status(path_matched);
-  status_reader_->get_subscription_matched_status(status_matched);
-  const bool connected = request_matched.current_count > 0 && progress_matched.current_count > 0 &&
-                         path_matched.current_count > 0 && status_matched.current_count > 0;
+  client_detail::Matches m;
+  bool matched_new_reader = false;
+  bool in_filter = true;
+  if (hub_ != nullptr) {
+    m = hub_->matches();
+    matched_new_reader = m.request_epoch != request_epoch_;
+    request_epoch_ = m.request_epoch;
+    in_filter = hub_->is_applied(options_.vehicle_id);
+  } else {
+    dds::PublicationMatchedStatus request_matched;
+    dds::PublicationMatchedStatus progress_matched;
+    dds::SubscriptionMatchedStatus path_matched;
+    dds::SubscriptionMatchedStatus status_matched;
+    // Reading a status also resets its trigger in the wait set.
+    request_writer_->get_publication_matched_status(request_matched);
+    progress_writer_->get_publication_matched_status(progress_matched);
+    path_reader_->get_subscription_matched_status(path_matched);
+    status_reader_->get_subscription_matched_status(status_matched);
+    m.request = request_matched.current_count;
+    m.progress = progress_matched.current_count;
+    m.path = path_matched.current_count;
+    m.status = status_matched.current_count;
+    matched_new_reader = request_matched.total_count_change > 0;
+  }
+  const bool connected = m.request > 0 && m.progress > 0 && m.path > 0 && m.status > 0 && in_filter;
   const auto now = SteadyClock::now();
   std::uint64_t resend_id = 0;
   SteadyClock::time_point next = now + kDispatchPeriod;
@@ -627,8 +1135,8 @@ SteadyClock::time_point Client::Impl::update_service_and_resend() {
     std::lock_guard<std::mutex> lock(state_mutex_);
     // A new reader of requests (a service that came back, or a second one): the volatile topic
     // gives it nothing that was written before, so the pending request goes again now.
-    const bool new_reader = request_matched.current_count > request_matches_ || request_matched.total_count_change > 0;
-    request_matches_ = request_matched.current_count;
+    const bool new_reader = m.request > request_matches_ || matched_new_reader;
+    request_matches_ = m.request;
     if (connected && service_state_ != ServiceState::kConnected) {
       service_state_ = ServiceState::kConnected;
       changed = true;
@@ -639,7 +1147,7 @@ SteadyClock::time_point Client::Impl::update_service_and_resend() {
     }
     if (resend_pending_locked(pending_.id, now)) {
       const auto due = pending_.last_write + options_.resend_period;
-      if ((new_reader && request_matched.current_count > 0) || (due <= now && request_matched.current_count > 0)) {
+      if ((new_reader && m.request > 0) || (due <= now && m.request > 0)) {
         resend_id = pending_.id;
         next = std::min(next, now + options_.resend_period);
       } else {
@@ -660,9 +1168,31 @@ void Client::Impl::report_progress(ExecutionProgress progress) {
   }
   if (progress.stamp_ns == 0) progress.stamp_ns = system_now_ns();
   msg::ExecutionProgress sample = idl::to_msg(progress);
-  if (!progress_writer_->write(&sample)) {
-    throw ClientError("cannot write progress for request " + std::to_string(progress.request_id));
+  wrote_progress_.store(true);  // before the write: a destroyed client unregisters the instance
+  const bool written = hub_ != nullptr ? hub_->write_progress(&sample) : progress_writer_->write(&sample);
+  if (!written) throw ClientError("cannot write progress for request " + std::to_string(progress.request_id));
+}
+
+bool Client::Impl::write_request(msg::PullOutRequest* sample) {
+  if (hub_ == nullptr) return request_writer_->write(sample);
+  wrote_request_.store(true);  // before the write: a destroyed client unregisters the instance
+  return hub_->write_request(sample);
+}
+
+void Client::Impl::push_path(std::shared_ptr<const PullOutPath> path) {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    inbox_paths_.push_back(std::move(path));
   }
+  wake_dispatcher();
+}
+
+void Client::Impl::push_status(std::shared_ptr<const PullOutStatus> status) {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    inbox_statuses_.push_back(std::move(status));
+  }
+  wake_dispatcher();
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -694,10 +1224,14 @@ void Client::Impl::on_status(StatusCallback callback) { replace_callback(status_
 
 void Client::Impl::run() {
   dds::WaitSet waitset;
-  waitset.attach_condition(path_reader_->get_statuscondition());
-  waitset.attach_condition(status_reader_->get_statuscondition());
-  waitset.attach_condition(request_writer_->get_statuscondition());
-  waitset.attach_condition(progress_writer_->get_statuscondition());
+  // With shared endpoints, the Hub wakes this thread (replies, matches).
+  const bool own = hub_ == nullptr;
+  if (own) {
+    waitset.attach_condition(path_reader_->get_statuscondition());
+    waitset.attach_condition(status_reader_->get_statuscondition());
+    waitset.attach_condition(request_writer_->get_statuscondition());
+    waitset.attach_condition(progress_writer_->get_statuscondition());
+  }
   waitset.attach_condition(wake_);
   dds::ConditionSeq active;
   SteadyClock::time_point next = SteadyClock::now();
@@ -714,14 +1248,21 @@ void Client::Impl::run() {
     next = update_service_and_resend();
   }
   waitset.detach_condition(wake_);
-  waitset.detach_condition(progress_writer_->get_statuscondition());
-  waitset.detach_condition(request_writer_->get_statuscondition());
-  waitset.detach_condition(status_reader_->get_statuscondition());
-  waitset.detach_condition(path_reader_->get_statuscondition());
+  if (own) {
+    waitset.detach_condition(progress_writer_->get_statuscondition());
+    waitset.detach_condition(request_writer_->get_statuscondition());
+    waitset.detach_condition(status_reader_->get_statuscondition());
+    waitset.detach_condition(path_reader_->get_statuscondition());
+  }
 }
 
 std::vector<std::shared_ptr<const PullOutPath>> Client::Impl::take_paths() {
   std::vector<std::shared_ptr<const PullOutPath>> out;
+  if (hub_ != nullptr) {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    out.swap(inbox_paths_);
+    return out;
+  }
   msg::PullOutPath sample;
   dds::SampleInfo info;
   while (path_reader_->take_next_sample(&sample, &info) == ReturnCode::RETCODE_OK) {
@@ -739,6 +1280,11 @@ std::vector<std::shared_ptr<const PullOutPath>> Client::Impl::take_paths() {
 
 std::vector<std::shared_ptr<const PullOutStatus>> Client::Impl::take_statuses() {
   std::vector<std::shared_ptr<const PullOutStatus>> out;
+  if (hub_ != nullptr) {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    out.swap(inbox_statuses_);
+    return out;
+  }
   msg::PullOutStatus sample;
   dds::SampleInfo info;
   while (status_reader_->take_next_sample(&sample, &info) == ReturnCode::RETCODE_OK) {
@@ -809,17 +1355,18 @@ void Client::Impl::dispatch_once() {
     for (auto& path : paths) {
       // Before the first send(), follow the request the service last answered (restart case).
       if (!sent_any_) current_request_id_ = path->request_id;
-      if (path->request_id == pending_.id) pending_.answered = true;
+      if (path->request_id == pending_.id) pending_.path_seen = true;
       Received<PullOutPath> item{++path_seq_, std::move(path)};
       if (path_slot_.callback) path_out.push_back(item);
       push_bounded(recent_paths_, std::move(item), kRecentPaths);
     }
     for (auto& status : statuses) {
-      if (status->request_id == pending_.id && status->state != ExecutionState::kPlanning) pending_.answered = true;
+      if (status->request_id == pending_.id && status->state != ExecutionState::kPlanning) pending_.status_seen = true;
       Received<PullOutStatus> item{++status_seq_, std::move(status)};
       if (status_slot_.callback) status_out.push_back(item);
       push_bounded(recent_statuses_, std::move(item), kRecentStatuses);
     }
+    update_answered_locked();
   }
   if (!paths.empty() || !statuses.empty()) state_cv_.notify_all();
 
@@ -957,7 +1504,8 @@ ClientParticipant::ClientParticipant(ClientParticipantOptions options) {
                                 " is outside 0.." + std::to_string(kMaxDomainId));
   }
   shared_ = std::make_shared<client_detail::SharedParticipant>(options.domain_id, std::move(options.profiles_file),
-                                                               options.participant_profile, std::string());
+                                                               options.participant_profile, std::string(),
+                                                               options.shared_endpoints);
 }
 
 ClientParticipant::~ClientParticipant() = default;

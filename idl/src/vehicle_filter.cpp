@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <unordered_set>
 
 namespace pullout::idl {
 
@@ -15,9 +16,15 @@ constexpr unsigned char kCdrLittleEndian = 0x01;
 constexpr std::size_t kHeaderBytes = 4;
 }  // namespace
 
-bool payload_has_vehicle_id(const unsigned char* data, std::size_t size, std::string_view vehicle_id) {
-  if (data == nullptr || size < kHeaderBytes + 4) return false;
-  if (data[0] != 0x00 || (data[1] != kCdrBigEndian && data[1] != kCdrLittleEndian)) return true;
+namespace {
+enum class PayloadId { kFound, kUnknownEncoding, kMalformed };
+
+// The vehicle id at the start of a serialized sample (see the header).
+PayloadId payload_vehicle_id(const unsigned char* data, std::size_t size, std::string_view& id) {
+  if (data == nullptr || size < kHeaderBytes + 4) return PayloadId::kMalformed;
+  if (data[0] != 0x00 || (data[1] != kCdrBigEndian && data[1] != kCdrLittleEndian)) {
+    return PayloadId::kUnknownEncoding;
+  }
   const unsigned char* p = data + kHeaderBytes;
   std::uint32_t length = 0;
   if (data[1] == kCdrLittleEndian) {
@@ -26,25 +33,126 @@ bool payload_has_vehicle_id(const unsigned char* data, std::size_t size, std::st
     length = std::uint32_t{p[3]} | std::uint32_t{p[2]} << 8 | std::uint32_t{p[1]} << 16 | std::uint32_t{p[0]} << 24;
   }
   const std::size_t available = size - kHeaderBytes - 4;
-  if (length > available) return false;
+  if (length > available) return PayloadId::kMalformed;
   const char* chars = reinterpret_cast<const char*>(p + 4);
   // The length counts the terminating NUL; tolerate a writer that omits it (length 0 for "").
   std::size_t n = length;
   if (n > 0 && chars[n - 1] == '\0') --n;
-  return n == vehicle_id.size() && std::memcmp(chars, vehicle_id.data(), n) == 0;
+  id = std::string_view(chars, n);
+  return PayloadId::kFound;
+}
+}  // namespace
+
+bool payload_has_vehicle_id(const unsigned char* data, std::size_t size, std::string_view vehicle_id) {
+  std::string_view id;
+  switch (payload_vehicle_id(data, size, id)) {
+    case PayloadId::kUnknownEncoding:
+      return true;
+    case PayloadId::kMalformed:
+      return false;
+    case PayloadId::kFound:
+      break;
+  }
+  return id == vehicle_id;
 }
 
+std::size_t vehicle_set_entry_bytes(std::string_view vehicle_id) {
+  return std::to_string(vehicle_id.size()).size() + 1 + vehicle_id.size();
+}
+
+std::vector<std::string> encode_vehicle_set(const std::vector<std::string>& ids) {
+  std::string all;
+  for (const auto& id : ids) {
+    all += std::to_string(id.size());
+    all += ':';
+    all += id;
+  }
+  std::vector<std::string> parameters;
+  for (std::size_t at = 0; at < all.size(); at += kVehicleSetParameterBytes) {
+    parameters.push_back(all.substr(at, kVehicleSetParameterBytes));
+  }
+  return parameters;
+}
+
+bool decode_vehicle_set(const std::vector<std::string_view>& parameters, std::vector<std::string>& ids) {
+  ids.clear();
+  if (parameters.size() > kMaxVehicleSetParameters) return false;
+  std::string all;
+  for (const auto& parameter : parameters) {
+    if (parameter.size() > kVehicleSetParameterBytes) return false;
+    all += parameter;
+  }
+  std::size_t at = 0;
+  while (at < all.size()) {
+    const std::size_t colon = all.find(':', at);
+    // Up to 3 digits: a vehicle id has at most kMaxVehicleIdBytes (255) bytes.
+    if (colon == std::string::npos || colon == at || colon - at > 3) return false;
+    std::size_t length = 0;
+    for (std::size_t i = at; i < colon; ++i) {
+      if (all[i] < '0' || all[i] > '9') return false;
+      length = length * 10 + static_cast<std::size_t>(all[i] - '0');
+    }
+    if (length == 0 || length > all.size() - colon - 1) return false;
+    ids.push_back(all.substr(colon + 1, length));
+    at = colon + 1 + length;
+  }
+  return true;
+}
+
+// One vehicle, a set of vehicles, or (parameters that made no filter on an update) everything.
 class VehicleIdFilterFactory::Filter final : public dds::IContentFilter {
  public:
-  explicit Filter(std::string vehicle_id) : vehicle_id_(std::move(vehicle_id)) {}
-
   bool evaluate(const SerializedPayload& payload, const FilterSampleInfo& /*sample_info*/,
                 const GUID_t& /*reader_guid*/) const override {
-    return payload_has_vehicle_id(payload.data, payload.length, vehicle_id_);
+    std::string_view id;
+    switch (payload_vehicle_id(payload.data, payload.length, id)) {
+      case PayloadId::kUnknownEncoding:
+        return true;
+      case PayloadId::kMalformed:
+        return false;
+      case PayloadId::kFound:
+        break;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (pass_all_) return true;
+    // std::unordered_set<std::string>::find needs a std::string before C++20.
+    return ids_.count(std::string(id)) != 0;
+  }
+
+  // Sets the filter from an expression and its parameters; false (and the filter unchanged) when
+  // they do not make one of ours.
+  bool assign(std::string_view expression, const std::vector<std::string_view>& parameters) {
+    std::vector<std::string> ids;
+    if (expression == kVehicleFilterExpression) {
+      if (parameters.size() != 1) return false;
+      ids.emplace_back(parameters[0]);
+    } else if (expression == kVehicleSetFilterExpression) {
+      if (!decode_vehicle_set(parameters, ids)) return false;
+    } else {
+      return false;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    expression_ = std::string(expression);
+    ids_ = std::unordered_set<std::string>(ids.begin(), ids.end());
+    pass_all_ = false;
+    return true;
+  }
+
+  void pass_all() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pass_all_ = true;
+  }
+
+  std::string expression() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return expression_;
   }
 
  private:
-  const std::string vehicle_id_;
+  mutable std::mutex mutex_;
+  std::string expression_;
+  std::unordered_set<std::string> ids_;
+  bool pass_all_{false};
 };
 
 VehicleIdFilterFactory::VehicleIdFilterFactory() = default;
@@ -58,14 +166,36 @@ ReturnCode VehicleIdFilterFactory::create_content_filter(const char* filter_clas
   if (filter_class_name == nullptr || std::strcmp(filter_class_name, kVehicleFilterClass) != 0) {
     return ReturnCode::RETCODE_BAD_PARAMETER;
   }
-  // A null expression asks to update the parameters of an existing filter: the client never does.
-  if (filter_expression == nullptr) return ReturnCode::RETCODE_UNSUPPORTED;
-  if (std::strcmp(filter_expression, kVehicleFilterExpression) != 0 || filter_parameters.length() != 1 ||
-      filter_parameters[0] == nullptr) {
-    return ReturnCode::RETCODE_BAD_PARAMETER;
+  std::vector<std::string_view> parameters;
+  bool null_parameter = false;
+  for (ParameterSeq::size_type i = 0; i < filter_parameters.length(); ++i) {
+    if (filter_parameters[i] == nullptr) {
+      null_parameter = true;
+      break;
+    }
+    parameters.emplace_back(filter_parameters[i]);
   }
+
   const bool new_entry = filter_instance == nullptr;
-  auto filter = std::make_unique<Filter>(filter_parameters[0]);
+  // An update of one of our filters: in place, never failing (see the header).
+  Filter* existing = nullptr;
+  if (filter_instance != nullptr) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& f : filters_) {
+      if (f.get() == filter_instance) existing = f.get();
+    }
+  }
+  if (existing != nullptr) {
+    // A null expression keeps the filter's own (ContentFilteredTopic::set_expression_parameters).
+    const std::string expression =
+        filter_expression != nullptr ? std::string(filter_expression) : existing->expression();
+    if (null_parameter || !existing->assign(expression, parameters)) existing->pass_all();
+    return ReturnCode::RETCODE_OK;
+  }
+
+  if (filter_expression == nullptr || null_parameter) return ReturnCode::RETCODE_BAD_PARAMETER;
+  auto filter = std::make_unique<Filter>();
+  if (!filter->assign(filter_expression, parameters)) return ReturnCode::RETCODE_BAD_PARAMETER;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     filter_instance = filter.get();

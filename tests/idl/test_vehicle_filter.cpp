@@ -1,7 +1,9 @@
 // The vehicle content filter: it reads vehicle_id straight from serialized samples, so
 // check it on samples serialized by the generated types, and on malformed payloads.
+#include <algorithm>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -108,6 +110,138 @@ TEST(VehicleFilterFactory, AcceptsOnlyItsExpression) {
 
   EXPECT_EQ(factory.delete_content_filter(kVehicleFilterClass, filter), ReturnCode::RETCODE_OK);
   EXPECT_EQ(factory.delete_content_filter(kVehicleFilterClass, filter), ReturnCode::RETCODE_BAD_PARAMETER);
+}
+
+// Whether `filter` keeps a status sample of `id`.
+bool keeps(const eprosima::fastdds::dds::IContentFilter* filter, const std::string& id) {
+  msg::PullOutStatus status;
+  status.vehicle_id(id);
+  const auto bytes = serialize<msg::PullOutStatusPubSubType>(status);
+  SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
+  std::copy(bytes.begin(), bytes.end(), payload.data);
+  payload.length = static_cast<std::uint32_t>(bytes.size());
+  return filter->evaluate(payload, {}, eprosima::fastrtps::rtps::GUID_t{});
+}
+
+struct Parameters {
+  explicit Parameters(std::vector<std::string> values) : strings(std::move(values)) {
+    seq.length(static_cast<eprosima::fastdds::dds::LoanableSequence<const char*>::size_type>(strings.size()));
+    for (std::size_t i = 0; i < strings.size(); ++i) seq[static_cast<int>(i)] = strings[i].c_str();
+  }
+  std::vector<std::string> strings;
+  eprosima::fastdds::dds::LoanableSequence<const char*> seq;
+};
+
+std::vector<std::string_view> views(const std::vector<std::string>& strings) {
+  return {strings.begin(), strings.end()};
+}
+
+TEST(VehicleSet, EncodingRoundTripsIdsThatSpanParametersAndContainSeparators) {
+  // Ids with ':' and digits in them, one of the maximum length (spans two 255-byte parameters).
+  const std::vector<std::string> ids{"a", "12:3", std::string(255, 'x'), "v:9:", "veh-0001"};
+  const auto parameters = encode_vehicle_set(ids);
+  std::size_t expected_bytes = 0;
+  for (const auto& id : ids) expected_bytes += vehicle_set_entry_bytes(id);
+  std::size_t total = 0;
+  for (const auto& p : parameters) {
+    EXPECT_LE(p.size(), kVehicleSetParameterBytes);
+    total += p.size();
+  }
+  EXPECT_EQ(total, expected_bytes);
+  EXPECT_GE(parameters.size(), 2u);
+  std::vector<std::string> decoded;
+  ASSERT_TRUE(decode_vehicle_set(views(parameters), decoded));
+  EXPECT_EQ(decoded, ids);
+  EXPECT_TRUE(encode_vehicle_set({}).empty());
+  ASSERT_TRUE(decode_vehicle_set({}, decoded));
+  EXPECT_TRUE(decoded.empty());
+}
+
+TEST(VehicleSet, MalformedEncodingsAreRejected) {
+  std::vector<std::string> ids;
+  for (const char* bad : {"x", "3:ab", ":a", "0:", "1a:b", "1234:a", "2:ab3"}) {
+    EXPECT_FALSE(decode_vehicle_set({bad}, ids)) << bad;
+  }
+  const std::vector<std::string> too_many(kMaxVehicleSetParameters + 1, "1:a");
+  EXPECT_FALSE(decode_vehicle_set(views(too_many), ids));
+}
+
+TEST(VehicleSetFilter, KeepsTheSetsVehiclesAndIsUpdatedInPlace) {
+  VehicleIdFilterFactory factory;
+  int hooks = 0;
+  factory.set_change_hook([&] { ++hooks; });
+  eprosima::fastdds::dds::IContentFilter* filter = nullptr;
+  using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
+  Parameters first(encode_vehicle_set({"v1", "v2"}));
+  ASSERT_EQ(
+      factory.create_content_filter(kVehicleFilterClass, "t", nullptr, kVehicleSetFilterExpression, first.seq, filter),
+      ReturnCode::RETCODE_OK);
+  ASSERT_NE(filter, nullptr);
+  EXPECT_EQ(hooks, 1);
+  EXPECT_TRUE(keeps(filter, "v1"));
+  EXPECT_TRUE(keeps(filter, "v2"));
+  EXPECT_FALSE(keeps(filter, "v3"));
+
+  // A writer's update (expression given) and a ContentFilteredTopic's (null expression): the same
+  // filter object, no hook (no entry added or erased at a writer).
+  auto* const original = filter;
+  Parameters second(encode_vehicle_set({"v2", "v3"}));
+  ASSERT_EQ(
+      factory.create_content_filter(kVehicleFilterClass, "t", nullptr, kVehicleSetFilterExpression, second.seq, filter),
+      ReturnCode::RETCODE_OK);
+  EXPECT_EQ(filter, original);
+  EXPECT_FALSE(keeps(filter, "v1"));
+  EXPECT_TRUE(keeps(filter, "v3"));
+  Parameters third(encode_vehicle_set({"v1"}));
+  ASSERT_EQ(factory.create_content_filter(kVehicleFilterClass, "t", nullptr, nullptr, third.seq, filter),
+            ReturnCode::RETCODE_OK);
+  EXPECT_EQ(filter, original);
+  EXPECT_TRUE(keeps(filter, "v1"));
+  EXPECT_FALSE(keeps(filter, "v2"));
+  Parameters none(std::vector<std::string>{});
+  ASSERT_EQ(factory.create_content_filter(kVehicleFilterClass, "t", nullptr, nullptr, none.seq, filter),
+            ReturnCode::RETCODE_OK);
+  EXPECT_FALSE(keeps(filter, "v1"));
+  EXPECT_EQ(hooks, 1);
+
+  EXPECT_EQ(factory.delete_content_filter(kVehicleFilterClass, filter), ReturnCode::RETCODE_OK);
+  EXPECT_EQ(hooks, 2);
+  // Updates no longer leave a filter behind: the one delete freed the only one.
+  EXPECT_EQ(factory.delete_content_filter(kVehicleFilterClass, original), ReturnCode::RETCODE_BAD_PARAMETER);
+}
+
+// Fast DDS 2.9.1 erases a writer's reader filter whose update fails (ReaderFilterCollection::
+// process_reader_filter_info), without the delete call the service's FilterGate waits for: an
+// update must never fail. Bad parameters make the filter pass everything (the client re-checks).
+TEST(VehicleSetFilter, AnUpdateWithBadParametersNeverFailsAndPassesEverything) {
+  VehicleIdFilterFactory factory;
+  eprosima::fastdds::dds::IContentFilter* filter = nullptr;
+  using ReturnCode = eprosima::fastrtps::types::ReturnCode_t;
+  Parameters one({"v1"});
+  ASSERT_EQ(factory.create_content_filter(kVehicleFilterClass, "t", nullptr, kVehicleFilterExpression, one.seq, filter),
+            ReturnCode::RETCODE_OK);
+  auto* const original = filter;
+  Parameters bad({"not an encoding"});
+  EXPECT_EQ(
+      factory.create_content_filter(kVehicleFilterClass, "t", nullptr, kVehicleSetFilterExpression, bad.seq, filter),
+      ReturnCode::RETCODE_OK);
+  EXPECT_EQ(filter, original);
+  EXPECT_TRUE(keeps(filter, "v1"));
+  EXPECT_TRUE(keeps(filter, "v9"));
+  // A later good update makes it a filter again.
+  Parameters good(encode_vehicle_set({"v9"}));
+  EXPECT_EQ(
+      factory.create_content_filter(kVehicleFilterClass, "t", nullptr, kVehicleSetFilterExpression, good.seq, filter),
+      ReturnCode::RETCODE_OK);
+  EXPECT_FALSE(keeps(filter, "v1"));
+  EXPECT_TRUE(keeps(filter, "v9"));
+  // A bad first creation still fails (no entry is made for it).
+  eprosima::fastdds::dds::IContentFilter* fresh = nullptr;
+  EXPECT_EQ(
+      factory.create_content_filter(kVehicleFilterClass, "t", nullptr, kVehicleSetFilterExpression, bad.seq, fresh),
+      ReturnCode::RETCODE_BAD_PARAMETER);
+  EXPECT_EQ(fresh, nullptr);
+  EXPECT_EQ(factory.delete_content_filter(kVehicleFilterClass, filter), ReturnCode::RETCODE_OK);
 }
 
 }  // namespace

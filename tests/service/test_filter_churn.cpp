@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -185,6 +186,149 @@ TEST(WriterFilterChurn, ReadersComingAndGoingWhileTheServicePublishesDoNotCrashI
   EXPECT_GT(rounds, 3);
   EXPECT_GT(writes.load(), 1000);
   std::printf("%d rounds of %d readers, %ld writes\n", rounds, kReadersPerRound, writes.load());
+}
+
+// One reader of statuses whose filter is a set of vehicles (a ClientParticipant's), changing its
+// set in place as its vehicles come and go.
+class SetReader {
+ public:
+  explicit SetReader(int domain) {
+    auto* factory = dds::DomainParticipantFactory::get_instance();
+    participant_ = factory->create_participant_with_profile(domain, "pullout_participant");
+    if (participant_ == nullptr) throw std::runtime_error("participant");
+    if (participant_->register_content_filter_factory(idl::kVehicleFilterClass, &filters_) !=
+        ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error("filter factory");
+    }
+    dds::TypeSupport type(idl::make_guarded_type<msg::PullOutStatusPubSubType>());
+    type.register_type(participant_);
+    topic_ = participant_->create_topic(idl::kStatusTopic, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+    if (topic_ == nullptr || subscriber_ == nullptr) throw std::runtime_error("topic/subscriber");
+    dds::DataReaderQos qos;
+    if (subscriber_->get_datareader_qos_from_profile(idl::kStatusReaderProfile, qos) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error("status reader profile");
+    }
+    filtered_ =
+        participant_->create_contentfilteredtopic(std::string(idl::kStatusTopic) + "/set", topic_,
+                                                  idl::kVehicleSetFilterExpression, {}, idl::kVehicleFilterClass);
+    if (filtered_ == nullptr) throw std::runtime_error("content filtered topic");
+    reader_ = subscriber_->create_datareader(filtered_, qos);
+    if (reader_ == nullptr) throw std::runtime_error("reader");
+  }
+
+  ~SetReader() {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+
+  bool set(const std::vector<std::string>& ids) {
+    return filtered_->set_expression_parameters(idl::encode_vehicle_set(ids)) == ReturnCode_t::RETCODE_OK;
+  }
+
+  // Takes everything received so far; returns the vehicle ids.
+  std::vector<std::string> take_all() {
+    std::vector<std::string> ids;
+    msg::PullOutStatus sample;
+    dds::SampleInfo info;
+    while (reader_->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data) ids.push_back(sample.vehicle_id());
+    }
+    return ids;
+  }
+
+ private:
+  idl::VehicleIdFilterFactory filters_;  // outlives the participant
+  dds::DomainParticipant* participant_{nullptr};
+  dds::Topic* topic_{nullptr};
+  dds::Subscriber* subscriber_{nullptr};
+  dds::ContentFilteredTopic* filtered_{nullptr};
+  dds::DataReader* reader_{nullptr};
+};
+
+// The service's writers update a reader's set filter in place, on a discovery thread, while the
+// writes evaluate it (the factory must never fail such an update: Fast DDS would erase the filter
+// behind FilterGate's back). Readers changing their sets every 10 ms while the service publishes:
+// no crash, and afterwards each reader gets its final set's vehicles and no other.
+TEST(WriterFilterChurn, SetReadersChangingTheirVehiclesWhileTheServicePublishes) {
+  eprosima::fastrtps::LibrarySettingsAttributes library;
+  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
+
+  integration::DomainLease lease;
+  Config config = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
+  config.dds.domain_id = lease.domain();
+  DdsEdge edge(config.dds);
+
+  std::atomic<bool> stop{false};
+  std::atomic<long> writes{0};
+  std::thread publisher([&] {
+    long n = 0;
+    while (!stop.load()) {
+      PullOutStatus status;
+      status.vehicle_id = vehicle_name(static_cast<int>((n * 7) % kVehicles));
+      status.request_id = static_cast<std::uint64_t>(n + 1);
+      edge.publish_status(status);
+      ++n;
+      writes.fetch_add(1);
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+  });
+
+  constexpr int kSetReaders = 3;
+  std::vector<std::unique_ptr<SetReader>> readers;
+  for (int r = 0; r < kSetReaders; ++r) readers.push_back(std::make_unique<SetReader>(lease.domain()));
+  // Sets drawn from vehicles 0..kVehicles/2-1 during the churn; the final sets come from the other
+  // half (disjoint from every earlier set: their first sample proves the writer has the final set).
+  const auto churn_end = Clock::now() + std::chrono::seconds(6);
+  int updates = 0;
+  while (Clock::now() < churn_end) {
+    for (int r = 0; r < kSetReaders; ++r) {
+      std::vector<std::string> ids;
+      for (int k = 0; k < 1 + (updates + r) % 5; ++k)
+        ids.push_back(vehicle_name((updates * 3 + r * 5 + k) % (kVehicles / 2)));
+      ASSERT_TRUE(readers[r]->set(ids));
+      readers[r]->take_all();
+    }
+    ++updates;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::vector<std::set<std::string>> finals(kSetReaders);
+  for (int r = 0; r < kSetReaders; ++r) {
+    std::vector<std::string> ids{vehicle_name(kVehicles / 2 + 2 * r), vehicle_name(kVehicles / 2 + 2 * r + 1)};
+    finals[r] = std::set<std::string>(ids.begin(), ids.end());
+    ASSERT_TRUE(readers[r]->set(ids));
+  }
+  for (int r = 0; r < kSetReaders; ++r) {
+    // Until a sample of the final set arrives (in the writer's order, every later one was
+    // filtered with the final set), then the next ones: all in the set, and both vehicles seen.
+    const auto deadline = Clock::now() + std::chrono::seconds(10);
+    bool final_seen = false;
+    while (!final_seen && Clock::now() < deadline) {
+      for (const auto& id : readers[r]->take_all()) final_seen = final_seen || finals[r].count(id) != 0;
+      if (!final_seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ASSERT_TRUE(final_seen) << "reader " << r << " got nothing of its final set";
+    std::set<std::string> seen;
+    int foreign = 0;
+    while (seen.size() < finals[r].size() && Clock::now() < deadline) {
+      for (const auto& id : readers[r]->take_all()) {
+        if (finals[r].count(id) != 0) {
+          seen.insert(id);
+        } else {
+          ++foreign;
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    EXPECT_EQ(seen, finals[r]) << "reader " << r;
+    EXPECT_EQ(foreign, 0) << "reader " << r;
+  }
+  stop = true;
+  publisher.join();
+  EXPECT_GT(updates, 50);
+  EXPECT_GT(writes.load(), 1000);
+  std::printf("%d set updates per reader, %ld writes\n", updates, writes.load());
 }
 
 }  // namespace

@@ -9,7 +9,9 @@
 // The path and status writers filter at the writer: the vehicle content filter factory
 // (pullout/idl/vehicle_filter.hpp) is registered on the participant, and each writer evaluates
 // the filters of up to idl::kMaxWriterReaderFilters remote readers (set in code: Fast DDS 2.9's
-// XML has no element for it), so each vehicle's samples are sent to that vehicle's readers only.
+// XML has no element for it), so each vehicle's samples are sent to that vehicle's readers only
+// (a single-vehicle client's reader, or a ClientParticipant's reader whose filter is the set of its
+// vehicles, updated in place by the factory when the client announces a new set).
 // Fast DDS 2.9.1 changes those filters on a discovery thread without the writer's lock; a gate
 // (FilterGate in dds_edge.cpp) keeps the writes out of such a change.
 //

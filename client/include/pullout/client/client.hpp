@@ -57,22 +57,49 @@
 // another thread is inside one of its member functions.
 //
 // Many vehicles on one participant (a vehicle gateway, a fleet simulator). A ClientParticipant owns
-// one DDS participant and the four topics; Clients constructed on it (Client(participant,
-// options)) each speak for their own vehicle as above, with their own request and progress writers
-// and their own vehicle-filtered path and status readers, the same re-sending, service state,
-// waits and callbacks, but no participant of their own: discovery traffic, sockets and the
-// participant's threads are paid once per participant instead of once per vehicle (one
-// participant per vehicle stops working at about 200 vehicles per process on a 2-core machine;
-// bench/RESULTS.md, "Load"). Each Client still has its own delivery thread. On a shared
-// participant, the domain, profiles file and participant profile are the participant's (the
-// corresponding ClientOptions fields are ignored) and security_dir must be empty (DDS Security
-// credentials belong to a participant, and a vehicle's permissions grant only its own id).
+// one DDS participant, the four topics and, by default (ClientParticipantOptions::
+// shared_endpoints), one request writer, one progress writer and one path and one status reader
+// for all the Clients constructed on it (Client(participant, options)). Each Client writes its
+// own instance (keyed by its vehicle id) and gets its own vehicle's replies, handed over by
+// vehicle id from the shared readers, whose content filter is the set of the participant's
+// vehicles, evaluated at the service's writers: the service sees one reader per participant, not
+// one per vehicle (one reader per vehicle made the reliability traffic grow as N^2 and stopped a
+// fleet at about 200 vehicles on a 2-core machine; bench/RESULTS.md, "Load"). A Client on it has
+// the same API, re-sending, service state, waits and callbacks as a single-vehicle Client, and its
+// own delivery thread, with these differences:
+//   - constructing or destroying a Client changes the set (the readers are announced again with
+//     the new set; changes within 20 ms are applied together). A Client is connected
+//     (wait_for_service) once its vehicle is in the set its readers announce. A reply the service
+//     writes before it has the new set is not sent to this participant; the Client's re-send
+//     (resend_period) repairs that;
+//   - the shared readers are created with the first set, once no Client was added for 20 ms, and
+//     the transient-local history (each vehicle's latest path and status from before) reaches
+//     them when they match the service, filtered by the set they have then: the Clients
+//     constructed together (in one go after the participant) get their vehicle's latest path and
+//     status as single-vehicle Clients do; a Client added later gets only the replies to its own
+//     requests;
+//   - a request is answered when both its path and a status past planning were received (not
+//     either): a Client that just joined the set can have one of the two filtered out at the
+//     service (the two readers' new set reaches the service's two writers one after the other),
+//     and the re-send has the service publish both again;
+//   - destroying a Client unregisters its request and progress instances (the service sees the
+//     vehicle go, as when a Client's own writers are deleted);
+//   - the set holds at most about 25 KB of ids (pullout/idl/vehicle_filter.hpp: about 2,300 ids
+//     of 8 bytes); a Client for which it has no room gets endpoints of its own, as below.
+// With shared_endpoints false, each Client has its own request and progress writers and its own
+// vehicle-filtered path and status readers on the shared participant (the service sees a reader
+// per vehicle). Either way, discovery traffic, sockets and the participant's threads are paid
+// once per participant instead of once per vehicle. On a shared participant, the domain, profiles
+// file and participant profile are the participant's (the corresponding ClientOptions fields are
+// ignored) and security_dir must be empty (DDS Security credentials belong to a participant, and a
+// vehicle's permissions grant only its own id: a secure vehicle uses the single-vehicle
+// constructor, with endpoints of its own in its vehicle's partition).
 // At most one Client per vehicle id is alive on a participant at a time. Constructing and
 // destroying Clients on one participant from several threads at once is allowed.
 // Lifetime: a ClientParticipant must outlive the Clients constructed on it (a Client keeps the
 // DDS participant alive anyway, so a violation leaks nothing: the DDS participant is deleted
-// with the last of them). Destroying a Client deletes only its own endpoints; the other Clients
-// on the participant are not disturbed.
+// with the last of them). Destroying a Client deletes only its own endpoints (or its place in the
+// shared ones); the other Clients on the participant are not disturbed.
 //
 // Units and frames are those of pullout/model/types.hpp. The public headers of this library
 // include no DDS header.
@@ -122,6 +149,10 @@ struct ClientParticipantOptions {
   std::string profiles_file;
   // Participant profile in profiles_file (ignored when profiles_file is empty).
   std::string participant_profile{"pullout_participant"};
+  // true: the Clients share one request writer, one progress writer and one path and one status
+  // reader (see "Many vehicles on one participant" above). false: each Client has endpoints of its
+  // own, as before (the comparison in bench_load --endpoints-per-client).
+  bool shared_endpoints{true};
 };
 
 namespace client_detail {
