@@ -370,3 +370,29 @@ TEST(Scenario, UnreadableFile) {
 
 }  // namespace
 }  // namespace pullout
+
+namespace pullout {
+namespace {
+
+TEST(ScenarioVehicle, AProfileIsNamedInTheRequestAndDimensionsAreCarried) {
+  ScenarioFile profile(std::string(kLanes) + kPoses + "vehicle: {profile: bus}\n");
+  const Scenario bus = load_scenario(profile.path());
+  EXPECT_EQ(bus.request.vehicle_profile, "bus");
+  EXPECT_FALSE(bus.request.vehicle);
+  EXPECT_NEAR(bus.vehicle.length_m(), 12.0, 1e-9);  // the config's bus, for the CLI's drawing
+
+  ScenarioFile own(std::string(kLanes) + kPoses + "vehicle: {wheel_base: 3.5}\n");
+  const Scenario van = load_scenario(own.path());
+  ASSERT_TRUE(van.request.vehicle);
+  EXPECT_DOUBLE_EQ(van.request.vehicle->wheel_base_m, 3.5);
+  EXPECT_TRUE(van.request.vehicle_profile.empty());
+
+  // Both at once is ambiguous; an unknown profile is the planner's to reject (the service has its own).
+  const auto both = problems_of(std::string(kLanes) + kPoses + "vehicle: {profile: bus, wheel_base: 3}\n");
+  ASSERT_EQ(both.size(), 1u);
+  EXPECT_NE(both[0].find("vehicle.profile"), std::string::npos) << both[0];
+  EXPECT_TRUE(problems_of(std::string(kLanes) + kPoses + "vehicle: {profile: tram}\n").empty());
+}
+
+}  // namespace
+}  // namespace pullout

@@ -122,7 +122,9 @@ SessionEffects VehicleSession::on_request(PullOutRequest request, const std::vec
   if (!issues.empty()) return reject(request.request_id, issues);
 
   const StartPlannerParameters& p = planner_.parameters();
-  if (path_ && safety_ && tracker_.active() && status_.state != ExecutionState::kCompleted &&
+  // The same goal for the same vehicle: a request for other dimensions is a new situation.
+  const bool same_vehicle = planner_.vehicle_for(request) == planned_vehicle_;
+  if (path_ && safety_ && tracker_.active() && status_.state != ExecutionState::kCompleted && same_vehicle &&
       same_goal(goal_, request.goal_pose)) {
     const bool latched = status_.departed;
     // Before departure the vehicle stands where the path starts; elsewhere it is a new situation.
@@ -147,7 +149,8 @@ SessionEffects VehicleSession::on_request(PullOutRequest request, const std::vec
   }
   // A re-plan before departure for the same goal keeps the turn signal's start, so that periodic
   // re-plans do not restart prepare_time_before_start.
-  const bool same_situation = has_path(status_.state) && !status_.departed && same_goal(goal_, request.goal_pose);
+  const bool same_situation =
+      has_path(status_.state) && !status_.departed && same_vehicle && same_goal(goal_, request.goal_pose);
   signal_carry_ =
       same_situation && status_.turn_signal_start_ns != 0
           ? std::make_optional(SignalStart{status_.turn_signal, status_.turn_signal_start_ns, signal_on_at_})
@@ -219,7 +222,8 @@ SessionEffects VehicleSession::on_result(std::uint64_t sequence, const PlanningR
       tracker_.start(path);
       path_ = path;
       published_ = path;
-      safety_.emplace(planner_.parameters(), planner_.vehicle(), result.world->lanes, objects_, path);
+      planned_vehicle_ = result.world->vehicle;
+      safety_.emplace(planner_.parameters(), planned_vehicle_, result.world->lanes, objects_, path);
       if (signal_carry_ && signal_carry_->signal == path.turn_signal) {
         status.turn_signal_start_ns = signal_carry_->stamp_ns;
         signal_on_at_ = signal_carry_->at;

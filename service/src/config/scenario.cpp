@@ -244,6 +244,27 @@ void set_overrides(const YAML::Node& planner, const StartPlannerParameters& para
   if (planner["search_policy"].IsDefined()) out.search_policy = params.search_policy;
 }
 
+// `vehicle:` (at `key`): either `{profile: NAME}` (a profile of the config the request is planned
+// with: the request names it, and the service resolves it) or dimension keys over the base
+// config's vehicle (the request carries them all). `vehicle` gets what the CLI draws.
+void read_vehicle(const YAML::Node& node, const std::string& key, const Config& base, VehicleInfo& vehicle,
+                  PullOutRequest& request, Problems& problems) {
+  if (node.IsMap() && node["profile"].IsDefined()) {
+    const auto name = yaml_fields::to_string(node["profile"], key + ".profile", problems);
+    if (node.size() > 1) {
+      problems.push_back(key + ".profile: give a profile or the vehicle's dimensions, not both" +
+                         yaml_fields::where(node));
+    }
+    if (!name) return;
+    request.vehicle_profile = *name;
+    const auto it = base.vehicle_profiles.find(*name);
+    if (it != base.vehicle_profiles.end()) vehicle = it->second;  // else the planner rejects the name
+    return;
+  }
+  apply_vehicle_info(node, key, vehicle, problems);
+  request.vehicle = vehicle;
+}
+
 }  // namespace
 
 Scenario load_scenario(const std::string& path, const Config& base) {
@@ -263,9 +284,7 @@ Scenario load_scenario(const std::string& path, const Config& base) {
   if (request.vehicle_id.empty()) problems.push_back("vehicle_id: must not be empty");
   request.request_id = kScenarioRequestId;
 
-  if (root.has("vehicle")) {
-    apply_vehicle_info(root.get("vehicle"), "vehicle", s.vehicle, problems);
-  }
+  if (root.has("vehicle")) read_vehicle(root.get("vehicle"), "vehicle", base, s.vehicle, request, problems);
   std::string map_file;
   if (root.read("map", map_file)) {
     std::filesystem::path file(map_file);

@@ -1,6 +1,8 @@
 // Scenario files: one YAML format for the CLI, the tests and the benchmarks (see DESIGN.md).
 //
-//   vehicle: {wheel_base: 2.79, ...}          # optional, overrides the config's vehicle
+//   vehicle: {wheel_base: 2.79, ...}          # optional, overrides the config's vehicle (and the
+//                                             # request carries it), or {profile: bus}: a profile of
+//                                             # the config's vehicle_profiles, named in the request
 //   map: ../maps/straight_shoulder.osm        # Lanelet2 map, relative to this file ...
 //   route: [101, 102, 103]                    # ... and the road lanelets to pull out onto, or
 //                                             # Autoware route segments: [{preferred: 101,

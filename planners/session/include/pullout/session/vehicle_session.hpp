@@ -172,6 +172,7 @@ class VehicleSession {
   // The found path being followed (as planned), its safety monitor and what was published of it.
   std::optional<PullOutPath> path_;
   std::optional<SafetyMonitor> safety_;
+  VehicleInfo planned_vehicle_;  // the vehicle path_ was planned for (its own, a profile's, the default)
   PullOutPath published_;
   bool stop_inserted_{false};
   // Turn signal and its start (stamp, service time) carried from a path a same-goal re-plan replaces.
