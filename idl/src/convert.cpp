@@ -564,6 +564,7 @@ msg::PullOutStatus to_msg(const PullOutStatus& in) {
   out.turn_signal(enum_to_msg<TurnSignal, msg::TurnSignal>(in.turn_signal));
   out.turn_signal_start(to_msg_time(in.turn_signal_start_ns));
   out.path_end(in.path_end);
+  out.waiting_for_vehicle_id(in.waiting_for_vehicle_id);
   return out;
 }
 
@@ -609,6 +610,7 @@ PullOutStatus from_msg(const msg::PullOutStatus& in, std::vector<RequestIssue>& 
   out.turn_signal = lenient_enum(in.turn_signal(), msg::TURN_SIGNAL_RIGHT, TurnSignal::kNone);
   out.turn_signal_start_ns = from_msg_time(in.turn_signal_start());
   out.path_end = in.path_end();
+  out.waiting_for_vehicle_id = in.waiting_for_vehicle_id();
   return out;
 }
 

@@ -529,5 +529,12 @@ TEST(Convert, MoreThanOneVehicleIsAnIssue) {
   EXPECT_EQ(issues[0].field, "vehicle");
 }
 
+TEST(Convert, TheVehicleWaitedForRoundTrips) {
+  PullOutStatus s;
+  s.vehicle_id = "fleet-b";
+  s.waiting_for_vehicle_id = "fleet-a";
+  EXPECT_EQ(from_msg(to_msg(s)).waiting_for_vehicle_id, "fleet-a");
+}
+
 }  // namespace
 }  // namespace pullout::idl

@@ -394,5 +394,23 @@ TEST(ScenarioVehicle, AProfileIsNamedInTheRequestAndDimensionsAreCarried) {
   EXPECT_TRUE(problems_of(std::string(kLanes) + kPoses + "vehicle: {profile: tram}\n").empty());
 }
 
+TEST(ScenarioFleet, TheOtherVehiclesShareTheWorldWithTheirOwnPosesAndVehicles) {
+  const Scenario sc = load_scenario(kScenarioDir + "/fleet_opposite_shoulders.yaml");
+  ASSERT_EQ(sc.fleet.size(), 1u);
+  EXPECT_EQ(sc.fleet[0].vehicle_id, "fleet-a");
+  EXPECT_EQ(sc.fleet[0].lanes.size(), sc.request.lanes.size());
+  EXPECT_DOUBLE_EQ(sc.fleet[0].ego_pose.y, 3.25);
+  EXPECT_EQ(sc.expect.waits_for, std::optional<std::string>("fleet-a"));
+
+  const auto p = problems_of(std::string(kLanes) + kPoses +
+                             "vehicle_id: me\nfleet:\n  - {vehicle_id: me, start: {x: 1, y: 0}, goal: {x: 9, y: 0}}\n"
+                             "  - {start: {x: 1, y: 0}, goal: {x: 9, y: 0}, colour: red, vehicle: {profile: 3}}\n");
+  std::string all;
+  for (const auto& line : p) all += line + "\n";
+  EXPECT_NE(all.find("fleet[0].vehicle_id: 'me' is this scenario's own vehicle"), std::string::npos) << all;
+  EXPECT_NE(all.find("fleet[1].vehicle_id: required"), std::string::npos) << all;
+  EXPECT_NE(all.find("fleet[1].colour"), std::string::npos) << all;
+}
+
 }  // namespace
 }  // namespace pullout

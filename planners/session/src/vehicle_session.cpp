@@ -22,7 +22,7 @@ bool same_goal(const Pose2& a, const Pose2& b) {
 bool same_status(const PullOutStatus& a, const PullOutStatus& b) {
   return a.state == b.state && a.current_path_idx == b.current_path_idx && a.stop_reason == b.stop_reason &&
          a.safe == b.safe && a.unsafe_object_id == b.unsafe_object_id && a.departed == b.departed &&
-         a.turn_signal_start_ns == b.turn_signal_start_ns;
+         a.turn_signal_start_ns == b.turn_signal_start_ns && a.waiting_for_vehicle_id == b.waiting_for_vehicle_id;
 }
 
 std::vector<std::string> issue_lines(const std::vector<RequestIssue>& issues) {
@@ -263,7 +263,22 @@ SessionEffects VehicleSession::on_search_failed(std::uint64_t sequence, const st
   return out;
 }
 
-SessionEffects VehicleSession::on_progress(const ExecutionProgress& progress, Clock::time_point now) {
+std::optional<ExecutingPath> VehicleSession::executing() const {
+  if (!path_ || !status_.departed || status_.state == ExecutionState::kCompleted || !has_path(status_.state)) {
+    return std::nullopt;
+  }
+  ExecutingPath e;
+  e.vehicle_id = vehicle_id_;
+  e.vehicle = planned_vehicle_;
+  e.path = *path_;
+  e.current_path_idx = status_.current_path_idx;
+  e.pose = last_sample_ ? last_sample_->pose : path_->partial_paths.front().points.front().pose;
+  e.velocity_mps = last_sample_ ? last_sample_->velocity : 0.0;
+  return e;
+}
+
+SessionEffects VehicleSession::on_progress(const ExecutionProgress& progress, Clock::time_point now,
+                                           const std::vector<FleetObstacle>& fleet) {
   SessionEffects out;
   last_input_ = now;
   if (!path_ || !has_path(status_.state) || status_.state == ExecutionState::kCompleted || !tracker_.active() ||
@@ -294,7 +309,7 @@ SessionEffects VehicleSession::on_progress(const ExecutionProgress& progress, Cl
   refused_.reset();
   refused_in_a_row_ = 0;
   last_sample_ = current;
-  if (!apply_departure_rules(progress, now, out)) return out;
+  if (!apply_departure_rules(progress, now, fleet, out)) return out;
   out.status = status_;
   return out;
 }
@@ -351,7 +366,7 @@ void VehicleSession::insert_stop(const Pose2& pose, double velocity, const std::
 }
 
 bool VehicleSession::apply_departure_rules(const ExecutionProgress& progress, Clock::time_point now,
-                                           SessionEffects& out) {
+                                           const std::vector<FleetObstacle>& fleet, SessionEffects& out) {
   const StartPlannerParameters& p = planner_.parameters();
   const PullOutStatus before = status_;
   PullOutStatus& s = status_;
@@ -362,7 +377,18 @@ bool VehicleSession::apply_departure_rules(const ExecutionProgress& progress, Cl
     s.stop_reason.clear();
     return true;
   }
-  const SafetyVerdict verdict = safety_->evaluate(progress.pose, progress.velocity_mps, s.current_path_idx, s.departed);
+  SafetyVerdict verdict = safety_->evaluate(progress.pose, progress.velocity_mps, s.current_path_idx, s.departed);
+  s.waiting_for_vehicle_id.clear();
+  if (verdict.safe) {
+    // Another vehicle's remaining path (or body) in the way of ours: wait for it.
+    if (const auto conflict = first_fleet_conflict(*path_, s.current_path_idx, progress.pose, planned_vehicle_,
+                                                   options_.fleet_clearance_m, fleet)) {
+      verdict.safe = false;
+      verdict.object_id = conflict->object_id;
+      verdict.reason = "waiting for vehicle '" + conflict->vehicle_id + "': its path crosses this one";
+      s.waiting_for_vehicle_id = conflict->vehicle_id;
+    }
+  }
   s.safe = verdict.safe;
   s.unsafe_object_id = verdict.safe ? 0 : verdict.object_id;
 

@@ -296,6 +296,9 @@ struct PullOutStatus {
   // A found path: how the published path ends, e.g. "stops 2.01 m before object 7, 20.9 m beyond
   // the end pose" (the path's velocity is 0 there), or where it ends when nothing is in the way.
   std::string path_end;
+  // Vehicles that see each other: the vehicle (its id) whose executing path crosses this one, so
+  // that this vehicle waits (kWaitingSafety before departure, a stop after); empty otherwise.
+  std::string waiting_for_vehicle_id;
 };
 
 // A problem with a request: the field (e.g. "lanes[2].left_bound[5].x", "ego_pose.orientation")
