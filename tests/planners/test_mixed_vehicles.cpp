@@ -2,6 +2,7 @@
 // dimensions, a profile of the config, or the default), and rejects bad ones naming the field.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 
 #include "pullout/collision/footprint.hpp"

@@ -501,8 +501,8 @@ TEST(VehicleProfiles, AFileReplacesTheProfilesAndKeysLeftOutTakeTheirDefaults) {
 }
 
 TEST(VehicleProfiles, BadProfilesAreNamed) {
-  const auto p = problems_of(std::string(kMinimal) +
-                             "vehicle_profiles:\n  bus: {wheel_base: 0, colour: red}\n  'a b': {}\n");
+  const auto p =
+      problems_of(std::string(kMinimal) + "vehicle_profiles:\n  bus: {wheel_base: 0, colour: red}\n  'a b': {}\n");
   const std::string all = dump(p);
   EXPECT_NE(all.find("vehicle_profiles.bus.wheel_base"), std::string::npos) << all;
   EXPECT_NE(all.find("vehicle_profiles.bus.colour"), std::string::npos) << all;

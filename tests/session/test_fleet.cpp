@@ -3,6 +3,7 @@
 // fleet_opposite_shoulders.yaml (fleet-a executing, fleet-b in the neighbouring spot), a fake clock.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -183,10 +184,11 @@ TEST(FleetObstacle, TheOtherVehicleIsItsOwnFootprintWithItsRemainingPathTimedByI
   ASSERT_EQ(o.object.predicted_paths.size(), 1u);
   const PredictedPath& predicted = o.object.predicted_paths.front();
   EXPECT_DOUBLE_EQ(predicted.time_step_s, kFleetTimeStep);
-  // 2 m/s: 1 m every 0.5 s, from x = 5 to x = 20 (15 m: 30 steps, the last one standing at the end).
-  ASSERT_GE(predicted.poses.size(), 31u);
-  EXPECT_NEAR(predicted.poses[4].x, 7.0, 1e-9);
-  EXPECT_NEAR(predicted.poses[30].x, 20.0, 1e-9);
+  // 2 m/s: 1 m every 0.5 s, from x = 5 to x = 20 (15 m in 7.5 s: 15 steps), then standing at the end.
+  ASSERT_EQ(predicted.poses.size(), 17u);
+  EXPECT_NEAR(predicted.poses[4].x, 9.0, 1e-9);
+  EXPECT_NEAR(predicted.poses[15].x, 20.0, 1e-9);
+  EXPECT_NEAR(predicted.poses[16].x, 20.0, 1e-9);
   // Body only: no path.
   EXPECT_TRUE(fleet_obstacle(other, false, -3).swept.empty());
   EXPECT_TRUE(fleet_obstacle(other, false, -3).object.predicted_paths.empty());

@@ -386,9 +386,8 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   const std::vector<Lane>* planned_lanes = nullptr;  // the lanes planned on, once known
   const auto finish = [&](PlanningResult& r) {
     if (r.outcome != PlanningResult::Outcome::kRejected) {
-      r.world = std::make_shared<const PlannedWorld>(
-          PlannedWorld{planned_lanes != nullptr ? *planned_lanes : std::vector<Lane>{}, request.objects,
-                       vehicle_for(request)});
+      r.world = std::make_shared<const PlannedWorld>(PlannedWorld{
+          planned_lanes != nullptr ? *planned_lanes : std::vector<Lane>{}, request.objects, vehicle_for(request)});
     }
     r.planning_time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     r.path.vehicle_id = request.vehicle_id;

@@ -161,7 +161,8 @@ std::vector<FleetObstacle> FleetBoard::obstacles_for(const std::string& vehicle_
                                                      double radius) const {
   std::vector<FleetObstacle> out;
   const auto self = entries_.find(vehicle_id);
-  const std::uint64_t own_order = self == entries_.end() ? std::numeric_limits<std::uint64_t>::max() : self->second.order;
+  const std::uint64_t own_order =
+      self == entries_.end() ? std::numeric_limits<std::uint64_t>::max() : self->second.order;
   std::int64_t next_id = -1;
   for (const auto& [id, entry] : entries_) {
     if (id == vehicle_id) continue;

@@ -8,6 +8,8 @@
 // regenerate config/pullout.yaml with `pullout_service --print-config`.
 #include <algorithm>
 #include <array>
+#include <cctype>
+#include <cmath>
 #include <string_view>
 
 #include <yaml-cpp/yaml.h>
@@ -483,6 +485,9 @@ const Table<ObservabilityConfig>& observability_table() {
   return t;
 }
 
+// [m] Rounded to the millimetre, for comments (4.89, not 4.890000000000001).
+double to_mm(double v) { return std::round(v * 1000.0) / 1000.0; }
+
 // A profile name: what a request's vehicle_profile must equal.
 bool valid_profile_name(const std::string& name) {
   return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](unsigned char c) {
@@ -505,16 +510,15 @@ Entry<Config> vehicle_profiles_entry() {
       return;
     }
     if (!node.IsMap()) {
-      r.problems().push_back(path + ": expected a mapping of profile names to vehicles" +
-                             yaml_fields::where(node));
+      r.problems().push_back(path + ": expected a mapping of profile names to vehicles" + yaml_fields::where(node));
       return;
     }
     VehicleProfiles profiles;
     for (const auto& item : node) {
       const std::string name = item.first.IsScalar() ? item.first.Scalar() : std::string();
       if (!valid_profile_name(name)) {
-        r.problems().push_back(path + ": profile name '" + name +
-                               "' must be 1..64 letters, digits, '_', '-' or '.'" + yaml_fields::where(item.first));
+        r.problems().push_back(path + ": profile name '" + name + "' must be 1..64 letters, digits, '_', '-' or '.'" +
+                               yaml_fields::where(item.first));
         continue;
       }
       VehicleInfo vehicle;
@@ -537,8 +541,8 @@ Entry<Config> vehicle_profiles_entry() {
     out.push_back({indent, "vehicle_profiles:", "", false});
     for (const auto& [name, vehicle] : c.vehicle_profiles) {
       out.push_back({indent + 2, name + ":",
-                     "vehicle_length " + encode(vehicle.length_m()) + " m, vehicle_width " +
-                         encode(vehicle.width_m()) + " m",
+                     "vehicle_length " + encode(to_mm(vehicle.length_m())) + " m, vehicle_width " +
+                         encode(to_mm(vehicle.width_m())) + " m",
                      false});
       write_table(vehicle_table(), vehicle, indent + 4, out);
     }
@@ -547,7 +551,6 @@ Entry<Config> vehicle_profiles_entry() {
 }
 
 }  // namespace
-
 
 const Table<Config>& config_file_table() {
   using T = Config;
