@@ -65,7 +65,6 @@ struct StraightShoulder {
   std::vector<pullout_msg_Lane> lanes;
   std::string vehicle_id;
   std::string vehicle_profile;  // empty: the service's vehicle (a C string must not be null)
-  pullout_msg_VehicleDimensions dimensions{};
   pullout_msg_PullOutRequest request{};
 
   StraightShoulder(const std::string& vehicle, std::uint64_t request_id) : vehicle_id(vehicle) {
