@@ -107,7 +107,8 @@ int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
   }
   // load_config and load_scenario have checked every parameter (ConfigError above).
 
-  const StartPlanner planner(scenario.vehicle, scenario.parameters, config.service.limits, scenario.map);
+  const StartPlanner planner(scenario.vehicle, scenario.parameters, config.service.limits, scenario.map,
+                             config.vehicle_profiles);
   // The service's budget rule: the request's deadline, else the configured default.
   const double budget_ms =
       scenario.request.deadline_ms > 0.0 ? scenario.request.deadline_ms : config.service.default_deadline_ms;

@@ -1025,6 +1025,11 @@ void Client::Impl::destroy_entities() noexcept {
 // Writing
 
 std::uint64_t Client::Impl::send(PullOutRequest request) {
+  // The vehicle's own profile or dimensions, unless this request names another.
+  if (request.vehicle_profile.empty() && !request.vehicle) {
+    request.vehicle_profile = options_.vehicle_profile;
+    request.vehicle = options_.vehicle;
+  }
   std::uint64_t id = 0;
   std::uint64_t previous = 0;
   const std::int64_t now = system_now_ns();

@@ -380,6 +380,18 @@ msg::PullOutRequest to_msg(const PullOutRequest& in) {
     out.overrides().search_policy(msg::POLICY_DISTANCE_PRIORITY);
   }
   out.deadline_ms(in.deadline_ms);
+  out.vehicle_profile(in.vehicle_profile);
+  if (in.vehicle) {
+    msg::VehicleDimensions v;
+    v.wheel_base(in.vehicle->wheel_base_m);
+    v.wheel_tread(in.vehicle->wheel_tread_m);
+    v.front_overhang(in.vehicle->front_overhang_m);
+    v.rear_overhang(in.vehicle->rear_overhang_m);
+    v.left_overhang(in.vehicle->left_overhang_m);
+    v.right_overhang(in.vehicle->right_overhang_m);
+    v.max_steer_angle(in.vehicle->max_steer_angle_rad);
+    out.vehicle().push_back(v);
+  }
   return out;
 }
 
@@ -430,6 +442,22 @@ PullOutRequest from_msg(const msg::PullOutRequest& in, std::vector<RequestIssue>
   out.deadline_ms = checked_number(in.deadline_ms(), "deadline_ms", sink);
   if (std::isfinite(in.deadline_ms()) && in.deadline_ms() < 0.0) {
     sink.add("deadline_ms", "must be >= 0 (0 = the service's default), got " + number_text(in.deadline_ms()));
+  }
+  out.vehicle_profile = in.vehicle_profile();
+  if (in.vehicle().size() > 1) {
+    sink.add("vehicle", "at most one vehicle, got " + std::to_string(in.vehicle().size()));
+  } else if (in.vehicle().size() == 1) {
+    // The ranges (and non-finite values) are checked by the planner's validation, field by field.
+    const msg::VehicleDimensions& v = in.vehicle().front();
+    VehicleInfo info;
+    info.wheel_base_m = v.wheel_base();
+    info.wheel_tread_m = v.wheel_tread();
+    info.front_overhang_m = v.front_overhang();
+    info.rear_overhang_m = v.rear_overhang();
+    info.left_overhang_m = v.left_overhang();
+    info.right_overhang_m = v.right_overhang();
+    info.max_steer_angle_rad = v.max_steer_angle();
+    out.vehicle = info;
   }
   return out;
 }
@@ -536,6 +564,7 @@ msg::PullOutStatus to_msg(const PullOutStatus& in) {
   out.turn_signal(enum_to_msg<TurnSignal, msg::TurnSignal>(in.turn_signal));
   out.turn_signal_start(to_msg_time(in.turn_signal_start_ns));
   out.path_end(in.path_end);
+  out.waiting_for_vehicle_id(in.waiting_for_vehicle_id);
   return out;
 }
 
@@ -581,6 +610,7 @@ PullOutStatus from_msg(const msg::PullOutStatus& in, std::vector<RequestIssue>& 
   out.turn_signal = lenient_enum(in.turn_signal(), msg::TURN_SIGNAL_RIGHT, TurnSignal::kNone);
   out.turn_signal_start_ns = from_msg_time(in.turn_signal_start());
   out.path_end = in.path_end();
+  out.waiting_for_vehicle_id = in.waiting_for_vehicle_id();
   return out;
 }
 

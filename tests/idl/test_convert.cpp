@@ -498,3 +498,43 @@ TEST(Convert, TimeSaturatesOutsideInt32Seconds) {
 
 }  // namespace
 }  // namespace pullout::idl
+
+namespace pullout::idl {
+namespace {
+
+TEST(Convert, TheRequestsVehicleRoundTrips) {
+  PullOutRequest in = sample_request();
+  std::vector<RequestIssue> issues;
+  EXPECT_FALSE(from_msg(to_msg(in), issues).vehicle);  // none given: none on the wire
+  in.vehicle_profile = "bus";
+  EXPECT_EQ(from_msg(to_msg(in), issues).vehicle_profile, "bus");
+  in.vehicle_profile.clear();
+  VehicleInfo v;
+  v.wheel_base_m = 5.9;
+  v.rear_overhang_m = 3.5;
+  v.max_steer_angle_rad = 0.6;
+  in.vehicle = v;
+  const PullOutRequest out = from_msg(to_msg(in), issues);
+  ASSERT_TRUE(out.vehicle);
+  EXPECT_EQ(*out.vehicle, v);
+  EXPECT_TRUE(issues.empty());
+}
+
+TEST(Convert, MoreThanOneVehicleIsAnIssue) {
+  msg::PullOutRequest m = to_msg(sample_request());
+  m.vehicle().resize(2);
+  std::vector<RequestIssue> issues;
+  from_msg(m, issues);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].field, "vehicle");
+}
+
+TEST(Convert, TheVehicleWaitedForRoundTrips) {
+  PullOutStatus s;
+  s.vehicle_id = "fleet-b";
+  s.waiting_for_vehicle_id = "fleet-a";
+  EXPECT_EQ(from_msg(to_msg(s)).waiting_for_vehicle_id, "fleet-a");
+}
+
+}  // namespace
+}  // namespace pullout::idl

@@ -64,6 +64,7 @@ struct StraightShoulder {
   std::vector<pullout_msg_Point> shoulder_right{{0.0, 1.75, 0.0}, {100.0, 1.75, 0.0}};
   std::vector<pullout_msg_Lane> lanes;
   std::string vehicle_id;
+  std::string vehicle_profile;  // empty: the service's vehicle (a C string must not be null)
   pullout_msg_PullOutRequest request{};
 
   StraightShoulder(const std::string& vehicle, std::uint64_t request_id) : vehicle_id(vehicle) {
@@ -81,6 +82,7 @@ struct StraightShoulder {
     lanes[1].speed_limit_mps = 13.89;
 
     request.vehicle_id = vehicle_id.data();
+    request.vehicle_profile = vehicle_profile.data();
     request.request_id = request_id;
     request.stamp = now_stamp();
     request.ego_pose = pose(10.0, 3.25);

@@ -478,3 +478,37 @@ TEST(Config, SafetyValuesAreRangeChecked) {
 
 }  // namespace
 }  // namespace pullout
+
+namespace pullout {
+namespace {
+
+TEST(VehicleProfiles, TheShippedProfilesAreACarAVanAndABus) {
+  const Config c = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
+  ASSERT_EQ(c.vehicle_profiles.size(), 3u);
+  EXPECT_EQ(c.vehicle_profiles.at("car"), VehicleInfo{});
+  EXPECT_NEAR(c.vehicle_profiles.at("bus").length_m(), 12.0, 1e-9);
+  EXPECT_GT(c.vehicle_profiles.at("van").length_m(), c.vehicle_profiles.at("car").length_m());
+}
+
+TEST(VehicleProfiles, AFileReplacesTheProfilesAndKeysLeftOutTakeTheirDefaults) {
+  const auto c = [] {
+    ConfigFile file(std::string(kMinimal) + "vehicle_profiles:\n  tram: {wheel_base: 9.0, rear_overhang: 4.0}\n");
+    return load_config(file.path());
+  }();
+  ASSERT_EQ(c.vehicle_profiles.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.vehicle_profiles.at("tram").wheel_base_m, 9.0);
+  EXPECT_DOUBLE_EQ(c.vehicle_profiles.at("tram").wheel_tread_m, VehicleInfo{}.wheel_tread_m);
+}
+
+TEST(VehicleProfiles, BadProfilesAreNamed) {
+  const auto p =
+      problems_of(std::string(kMinimal) + "vehicle_profiles:\n  bus: {wheel_base: 0, colour: red}\n  'a b': {}\n");
+  const std::string all = dump(p);
+  EXPECT_NE(all.find("vehicle_profiles.bus.wheel_base"), std::string::npos) << all;
+  EXPECT_NE(all.find("vehicle_profiles.bus.colour"), std::string::npos) << all;
+  EXPECT_NE(all.find("profile name 'a b'"), std::string::npos) << all;
+  EXPECT_FALSE(problems_of(std::string(kMinimal) + "vehicle_profiles: [bus]\n").empty());
+}
+
+}  // namespace
+}  // namespace pullout

@@ -370,3 +370,47 @@ TEST(Scenario, UnreadableFile) {
 
 }  // namespace
 }  // namespace pullout
+
+namespace pullout {
+namespace {
+
+TEST(ScenarioVehicle, AProfileIsNamedInTheRequestAndDimensionsAreCarried) {
+  ScenarioFile profile(std::string(kLanes) + kPoses + "vehicle: {profile: bus}\n");
+  const Scenario bus = load_scenario(profile.path());
+  EXPECT_EQ(bus.request.vehicle_profile, "bus");
+  EXPECT_FALSE(bus.request.vehicle);
+  EXPECT_NEAR(bus.vehicle.length_m(), 12.0, 1e-9);  // the config's bus, for the CLI's drawing
+
+  ScenarioFile own(std::string(kLanes) + kPoses + "vehicle: {wheel_base: 3.5}\n");
+  const Scenario van = load_scenario(own.path());
+  ASSERT_TRUE(van.request.vehicle);
+  EXPECT_DOUBLE_EQ(van.request.vehicle->wheel_base_m, 3.5);
+  EXPECT_TRUE(van.request.vehicle_profile.empty());
+
+  // Both at once is ambiguous; an unknown profile is the planner's to reject (the service has its own).
+  const auto both = problems_of(std::string(kLanes) + kPoses + "vehicle: {profile: bus, wheel_base: 3}\n");
+  ASSERT_EQ(both.size(), 1u);
+  EXPECT_NE(both[0].find("vehicle.profile"), std::string::npos) << both[0];
+  EXPECT_TRUE(problems_of(std::string(kLanes) + kPoses + "vehicle: {profile: tram}\n").empty());
+}
+
+TEST(ScenarioFleet, TheOtherVehiclesShareTheWorldWithTheirOwnPosesAndVehicles) {
+  const Scenario sc = load_scenario(kScenarioDir + "/fleet_opposite_shoulders.yaml");
+  ASSERT_EQ(sc.fleet.size(), 1u);
+  EXPECT_EQ(sc.fleet[0].vehicle_id, "fleet-a");
+  EXPECT_EQ(sc.fleet[0].lanes.size(), sc.request.lanes.size());
+  EXPECT_DOUBLE_EQ(sc.fleet[0].ego_pose.y, 3.25);
+  EXPECT_EQ(sc.expect.waits_for, std::optional<std::string>("fleet-a"));
+
+  const auto p = problems_of(std::string(kLanes) + kPoses +
+                             "vehicle_id: me\nfleet:\n  - {vehicle_id: me, start: {x: 1, y: 0}, goal: {x: 9, y: 0}}\n"
+                             "  - {start: {x: 1, y: 0}, goal: {x: 9, y: 0}, colour: red, vehicle: {profile: 3}}\n");
+  std::string all;
+  for (const auto& line : p) all += line + "\n";
+  EXPECT_NE(all.find("fleet[0].vehicle_id: 'me' is this scenario's own vehicle"), std::string::npos) << all;
+  EXPECT_NE(all.find("fleet[1].vehicle_id: required"), std::string::npos) << all;
+  EXPECT_NE(all.find("fleet[1].colour"), std::string::npos) << all;
+}
+
+}  // namespace
+}  // namespace pullout

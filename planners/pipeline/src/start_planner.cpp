@@ -260,8 +260,50 @@ bool planner_available(PlannerType type) {
 }
 
 StartPlanner::StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits,
-                           std::shared_ptr<const LaneletMap> map)
-    : vehicle_(vehicle), parameters_(std::move(parameters)), limits_(limits), map_(std::move(map)) {}
+                           std::shared_ptr<const LaneletMap> map, VehicleProfiles profiles)
+    : vehicle_(vehicle),
+      parameters_(std::move(parameters)),
+      limits_(limits),
+      map_(std::move(map)),
+      profiles_(std::move(profiles)) {}
+
+std::vector<RequestIssue> StartPlanner::vehicle_issues(const PullOutRequest& request) const {
+  std::vector<RequestIssue> issues;
+  if (!request.vehicle_profile.empty()) {
+    if (request.vehicle) {
+      issues.push_back({"vehicle_profile", "give a vehicle profile or the vehicle's dimensions (vehicle), not both"});
+    }
+    if (request.vehicle_profile.size() > kMaxVehicleProfileBytes) {
+      issues.push_back(
+          {"vehicle_profile", "longer than " + std::to_string(kMaxVehicleProfileBytes) + " bytes: no such profile"});
+    } else if (profiles_.count(request.vehicle_profile) == 0) {
+      std::string known;
+      for (const auto& [name, info] : profiles_) known += (known.empty() ? "" : ", ") + name;
+      issues.push_back({"vehicle_profile", "unknown profile '" + request.vehicle_profile + "' (the service has " +
+                                               (known.empty() ? std::string("none") : known) + ")"});
+    }
+  }
+  if (request.vehicle) {
+    for (const VehicleField& f : kVehicleFields) {
+      const double v = (*request.vehicle).*f.member;
+      if (!std::isfinite(v) || v < f.min || v > f.max) {
+        std::ostringstream problem;
+        problem << "must be in [" << f.min << ", " << f.max << "] " << f.unit << ", got " << v;
+        issues.push_back({std::string("vehicle.") + f.key, problem.str()});
+      }
+    }
+  }
+  return issues;
+}
+
+VehicleInfo StartPlanner::vehicle_for(const PullOutRequest& request) const {
+  if (request.vehicle) return *request.vehicle;
+  if (!request.vehicle_profile.empty()) {
+    const auto it = profiles_.find(request.vehicle_profile);
+    if (it != profiles_.end()) return it->second;
+  }
+  return vehicle_;
+}
 
 double planning_horizon_m(const StartPlannerParameters& p, const VehicleInfo& vehicle) {
   const TargetFilteringParameters& f = p.path_safety_check.target_filtering;
@@ -282,19 +324,22 @@ double planning_horizon_m(const StartPlannerParameters& p, const VehicleInfo& ve
 std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) const {
   auto issues =
       validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
+  for (auto& issue : vehicle_issues(request)) issues.push_back(std::move(issue));
   if (!issues.empty() || (request.lanes.empty() && !has_route(request))) return issues;
-  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_, limits_);
+  const VehicleInfo vehicle = vehicle_for(request);
+  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle, parameters_, limits_);
   if (!lanes.issues.empty()) return lanes.issues;
   // No LaneWorld here: its index and outline cost far more than this one question, and
   // validation runs without the request's deadline (VehicleSession::on_request). O(vertices).
   const bool inside = lanes_contain(lanes.lanes, to_vec(request.ego_pose));
-  if (auto issue = check_start_on_lanes(lanes.lanes, inside, request.ego_pose, vehicle_)) issues.push_back(*issue);
+  if (auto issue = check_start_on_lanes(lanes.lanes, inside, request.ego_pose, vehicle)) issues.push_back(*issue);
   return issues;
 }
 
 bool StartPlanner::grid_only_allowed() const { return parameters_.freespace_planner.enable_freespace_planner; }
 
-PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const StopCondition& stop) const {
+PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const VehicleInfo& vehicle,
+                                            const StopCondition& stop) const {
   PlanningResult result;
   const FreespaceParameters& p = parameters_.freespace_planner;
   std::vector<Polygon> obstacles;
@@ -313,7 +358,7 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
     r.status = r.stopped == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
                                                    : HybridAStarResult::Status::kTimeout;
   } else {
-    r = plan_freespace_to_goal(costmap, vehicle_, p, request.ego_pose, request.goal_pose, stop);
+    r = plan_freespace_to_goal(costmap, vehicle, p, request.ego_pose, request.goal_pose, stop);
   }
   const double margin = 0.5 * p.vehicle_shape_margin;
   const Failure f =
@@ -322,7 +367,7 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
   if (r.status == HybridAStarResult::Status::kSuccess) {
     result.outcome = PlanningResult::Outcome::kFound;
     result.path = std::move(r.path);
-    publish_checked(result, static_obstacle_checker(request, vehicle_, parameters_), margin, parameters_);
+    publish_checked(result, static_obstacle_checker(request, vehicle, parameters_), margin, parameters_);
     return result;
   }
   // Only the caller's limits make the planning time out; freespace's own time_limit is in the row.
@@ -341,8 +386,8 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   const std::vector<Lane>* planned_lanes = nullptr;  // the lanes planned on, once known
   const auto finish = [&](PlanningResult& r) {
     if (r.outcome != PlanningResult::Outcome::kRejected) {
-      r.world = std::make_shared<const PlannedWorld>(
-          PlannedWorld{planned_lanes != nullptr ? *planned_lanes : std::vector<Lane>{}, request.objects});
+      r.world = std::make_shared<const PlannedWorld>(PlannedWorld{
+          planned_lanes != nullptr ? *planned_lanes : std::vector<Lane>{}, request.objects, vehicle_for(request)});
     }
     r.planning_time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     r.path.vehicle_id = request.vehicle_id;
@@ -364,17 +409,21 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
 
   result.issues =
       validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
+  for (auto& issue : vehicle_issues(request)) result.issues.push_back(std::move(issue));
   if (!result.issues.empty()) {
     result.outcome = PlanningResult::Outcome::kRejected;
     finish(result);
     return result;
   }
+  // This request's vehicle (its own, a profile's, or the configured one): every footprint, turning
+  // radius and horizon below is its.
+  const VehicleInfo vehicle = vehicle_for(request);
   if (request.lanes.empty() && !has_route(request)) {  // validation allowed it: a grid and freespace
-    result = plan_grid_only(request, stop);
+    result = plan_grid_only(request, vehicle, stop);
     finish(result);
     return result;
   }
-  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle_, parameters_, limits_);
+  const RequestLanes lanes = request_lanes(request, map_.get(), vehicle, parameters_, limits_);
   if (!lanes.issues.empty()) {
     result.issues = lanes.issues;
     result.outcome = PlanningResult::Outcome::kRejected;
@@ -385,7 +434,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   const LaneWorld world(lanes.lanes, stop);
   if (world.stopped() != StopReason::kNone) return stopped_early(result, world.stopped());
   if (auto issue =
-          check_start_on_lanes(lanes.lanes, world.contains(to_vec(request.ego_pose)), request.ego_pose, vehicle_)) {
+          check_start_on_lanes(lanes.lanes, world.contains(to_vec(request.ego_pose)), request.ego_pose, vehicle)) {
     result.issues.push_back(*issue);
     result.outcome = PlanningResult::Outcome::kRejected;
     finish(result);
@@ -407,7 +456,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   // All of them are considered, wherever they stand (Autoware keeps only those overlapping the
   // pull-out lanes, which misses a car standing half on the kerb next to the path).
   // Only those that may reach into the planning horizon: no path or check comes near the others.
-  const Aabb near_square = horizon_square(request.ego_pose.x, request.ego_pose.y, planning_horizon_m(params, vehicle_));
+  const Aabb near_square = horizon_square(request.ego_pose.x, request.ego_pose.y, planning_horizon_m(params, vehicle));
   std::vector<Obstacle> obstacles;
   std::vector<Polygon> obstacle_polygons;
   for (const Object& o : request.objects) {
@@ -417,7 +466,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     obstacles.push_back({o.id, object_polygon(o)});
     obstacle_polygons.push_back(obstacles.back().polygon);
   }
-  const ObjectChecker checker(vehicle_footprint(vehicle_), std::move(obstacles));
+  const ObjectChecker checker(vehicle_footprint(vehicle), std::move(obstacles));
   // The lanes the vehicle stands in: the shoulder chain when it is on a shoulder, else the road.
   LaneChain shoulder;
   const LaneChain* pull_out = &road;
@@ -441,7 +490,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
                                 road,
                                 *pull_out,
                                 checker,
-                                vehicle_,
+                                vehicle,
                                 params,
                                 request.goal_pose,
                                 horizon,

@@ -22,7 +22,7 @@ bool same_goal(const Pose2& a, const Pose2& b) {
 bool same_status(const PullOutStatus& a, const PullOutStatus& b) {
   return a.state == b.state && a.current_path_idx == b.current_path_idx && a.stop_reason == b.stop_reason &&
          a.safe == b.safe && a.unsafe_object_id == b.unsafe_object_id && a.departed == b.departed &&
-         a.turn_signal_start_ns == b.turn_signal_start_ns;
+         a.turn_signal_start_ns == b.turn_signal_start_ns && a.waiting_for_vehicle_id == b.waiting_for_vehicle_id;
 }
 
 std::vector<std::string> issue_lines(const std::vector<RequestIssue>& issues) {
@@ -122,7 +122,9 @@ SessionEffects VehicleSession::on_request(PullOutRequest request, const std::vec
   if (!issues.empty()) return reject(request.request_id, issues);
 
   const StartPlannerParameters& p = planner_.parameters();
-  if (path_ && safety_ && tracker_.active() && status_.state != ExecutionState::kCompleted &&
+  // The same goal for the same vehicle: a request for other dimensions is a new situation.
+  const bool same_vehicle = planner_.vehicle_for(request) == planned_vehicle_;
+  if (path_ && safety_ && tracker_.active() && status_.state != ExecutionState::kCompleted && same_vehicle &&
       same_goal(goal_, request.goal_pose)) {
     const bool latched = status_.departed;
     // Before departure the vehicle stands where the path starts; elsewhere it is a new situation.
@@ -147,7 +149,8 @@ SessionEffects VehicleSession::on_request(PullOutRequest request, const std::vec
   }
   // A re-plan before departure for the same goal keeps the turn signal's start, so that periodic
   // re-plans do not restart prepare_time_before_start.
-  const bool same_situation = has_path(status_.state) && !status_.departed && same_goal(goal_, request.goal_pose);
+  const bool same_situation =
+      has_path(status_.state) && !status_.departed && same_vehicle && same_goal(goal_, request.goal_pose);
   signal_carry_ =
       same_situation && status_.turn_signal_start_ns != 0
           ? std::make_optional(SignalStart{status_.turn_signal, status_.turn_signal_start_ns, signal_on_at_})
@@ -219,7 +222,8 @@ SessionEffects VehicleSession::on_result(std::uint64_t sequence, const PlanningR
       tracker_.start(path);
       path_ = path;
       published_ = path;
-      safety_.emplace(planner_.parameters(), planner_.vehicle(), result.world->lanes, objects_, path);
+      planned_vehicle_ = result.world->vehicle;
+      safety_.emplace(planner_.parameters(), planned_vehicle_, result.world->lanes, objects_, path);
       if (signal_carry_ && signal_carry_->signal == path.turn_signal) {
         status.turn_signal_start_ns = signal_carry_->stamp_ns;
         signal_on_at_ = signal_carry_->at;
@@ -259,7 +263,22 @@ SessionEffects VehicleSession::on_search_failed(std::uint64_t sequence, const st
   return out;
 }
 
-SessionEffects VehicleSession::on_progress(const ExecutionProgress& progress, Clock::time_point now) {
+std::optional<ExecutingPath> VehicleSession::executing() const {
+  if (!path_ || !status_.departed || status_.state == ExecutionState::kCompleted || !has_path(status_.state)) {
+    return std::nullopt;
+  }
+  ExecutingPath e;
+  e.vehicle_id = vehicle_id_;
+  e.vehicle = planned_vehicle_;
+  e.path = *path_;
+  e.current_path_idx = status_.current_path_idx;
+  e.pose = last_sample_ ? last_sample_->pose : path_->partial_paths.front().points.front().pose;
+  e.velocity_mps = last_sample_ ? last_sample_->velocity : 0.0;
+  return e;
+}
+
+SessionEffects VehicleSession::on_progress(const ExecutionProgress& progress, Clock::time_point now,
+                                           const std::vector<FleetObstacle>& fleet) {
   SessionEffects out;
   last_input_ = now;
   if (!path_ || !has_path(status_.state) || status_.state == ExecutionState::kCompleted || !tracker_.active() ||
@@ -290,7 +309,7 @@ SessionEffects VehicleSession::on_progress(const ExecutionProgress& progress, Cl
   refused_.reset();
   refused_in_a_row_ = 0;
   last_sample_ = current;
-  if (!apply_departure_rules(progress, now, out)) return out;
+  if (!apply_departure_rules(progress, now, fleet, out)) return out;
   out.status = status_;
   return out;
 }
@@ -347,7 +366,7 @@ void VehicleSession::insert_stop(const Pose2& pose, double velocity, const std::
 }
 
 bool VehicleSession::apply_departure_rules(const ExecutionProgress& progress, Clock::time_point now,
-                                           SessionEffects& out) {
+                                           const std::vector<FleetObstacle>& fleet, SessionEffects& out) {
   const StartPlannerParameters& p = planner_.parameters();
   const PullOutStatus before = status_;
   PullOutStatus& s = status_;
@@ -358,7 +377,18 @@ bool VehicleSession::apply_departure_rules(const ExecutionProgress& progress, Cl
     s.stop_reason.clear();
     return true;
   }
-  const SafetyVerdict verdict = safety_->evaluate(progress.pose, progress.velocity_mps, s.current_path_idx, s.departed);
+  SafetyVerdict verdict = safety_->evaluate(progress.pose, progress.velocity_mps, s.current_path_idx, s.departed);
+  s.waiting_for_vehicle_id.clear();
+  if (verdict.safe) {
+    // Another vehicle's remaining path (or body) in the way of ours: wait for it.
+    if (const auto conflict = first_fleet_conflict(*path_, s.current_path_idx, progress.pose, planned_vehicle_,
+                                                   options_.fleet_clearance_m, fleet)) {
+      verdict.safe = false;
+      verdict.object_id = conflict->object_id;
+      verdict.reason = "waiting for vehicle '" + conflict->vehicle_id + "': its path crosses this one";
+      s.waiting_for_vehicle_id = conflict->vehicle_id;
+    }
+  }
   s.safe = verdict.safe;
   s.unsafe_object_id = verdict.safe ? 0 : verdict.object_id;
 

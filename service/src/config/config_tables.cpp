@@ -8,7 +8,11 @@
 // regenerate config/pullout.yaml with `pullout_service --print-config`.
 #include <algorithm>
 #include <array>
+#include <cctype>
+#include <cmath>
 #include <string_view>
+
+#include <yaml-cpp/yaml.h>
 
 #include "config/config_table.hpp"
 
@@ -255,19 +259,15 @@ const Table<FreespaceParameters>& freespace_table() {
 }  // namespace
 
 const Table<VehicleInfo>& vehicle_table() {
-  using T = VehicleInfo;
-  static const Table<T> t{{
-      field("wheel_base", &T::wheel_base_m, "m", in(0.1, 20.0), "front to rear axle"),
-      field("wheel_tread", &T::wheel_tread_m, "m", in(0.1, 5.0), "distance between the left and right wheels"),
-      field("front_overhang", &T::front_overhang_m, "m", in(0.0, 10.0), "front axle to the front bumper"),
-      field("rear_overhang", &T::rear_overhang_m, "m", in(0.0, 10.0), "rear axle to the rear bumper"),
-      field("left_overhang", &T::left_overhang_m, "m", in(0.0, 2.0),
-            "left wheel outer face to the left side of the body"),
-      field("right_overhang", &T::right_overhang_m, "m", in(0.0, 2.0),
-            "right wheel outer face to the right side of the body"),
-      // Below pi/2 so that the minimum turning radius (wheel_base / tan) is positive and finite.
-      field("max_steer_angle", &T::max_steer_angle_rad, "rad", in(0.01, 1.5), ""),
-  }};
+  // The keys, units and ranges are the core's (kVehicleFields): a request's own vehicle is checked
+  // against the same ones.
+  static const Table<VehicleInfo> t = [] {
+    Table<VehicleInfo> table;
+    for (const VehicleField& f : kVehicleFields) {
+      table.entries.push_back(field(f.key, f.member, f.unit, in(f.min, f.max), f.comment));
+    }
+    return table;
+  }();
   return t;
 }
 
@@ -485,6 +485,71 @@ const Table<ObservabilityConfig>& observability_table() {
   return t;
 }
 
+// [m] Rounded to the millimetre, for comments (4.89, not 4.890000000000001).
+double to_mm(double v) { return std::round(v * 1000.0) / 1000.0; }
+
+// A profile name: what a request's vehicle_profile must equal.
+bool valid_profile_name(const std::string& name) {
+  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](unsigned char c) {
+    return std::isalnum(c) != 0 || c == '_' || c == '-' || c == '.';
+  });
+}
+
+// `vehicle_profiles`: a mapping of names to vehicles, each read with the vehicle table (a key a
+// profile leaves out takes VehicleInfo's default). A file that has the key replaces the default
+// profiles whole.
+Entry<Config> vehicle_profiles_entry() {
+  Entry<Config> e;
+  e.key = "vehicle_profiles";
+  e.read = [](MapReader& r, Config& c) {
+    if (!r.has("vehicle_profiles")) return;
+    const YAML::Node node = r.get("vehicle_profiles");
+    const std::string path = r.key_path("vehicle_profiles");
+    if (node.IsNull()) {
+      c.vehicle_profiles.clear();
+      return;
+    }
+    if (!node.IsMap()) {
+      r.problems().push_back(path + ": expected a mapping of profile names to vehicles" + yaml_fields::where(node));
+      return;
+    }
+    VehicleProfiles profiles;
+    for (const auto& item : node) {
+      const std::string name = item.first.IsScalar() ? item.first.Scalar() : std::string();
+      if (!valid_profile_name(name)) {
+        r.problems().push_back(path + ": profile name '" + name + "' must be 1..64 letters, digits, '_', '-' or '.'" +
+                               yaml_fields::where(item.first));
+        continue;
+      }
+      VehicleInfo vehicle;
+      MapReader sub(item.second, join_path(path, name), r.problems());
+      if (sub.valid()) read_table(vehicle_table(), sub, vehicle);
+      profiles[name] = vehicle;
+    }
+    c.vehicle_profiles = std::move(profiles);
+  };
+  e.check = [](const Config& c, const std::string& prefix, Problems& out) {
+    for (const auto& [name, vehicle] : c.vehicle_profiles) {
+      if (!valid_profile_name(name)) {
+        out.push_back(join_path(prefix, "vehicle_profiles") + ": profile name '" + name +
+                      "' must be 1..64 letters, digits, '_', '-' or '.'");
+      }
+      check_table(vehicle_table(), vehicle, join_path(join_path(prefix, "vehicle_profiles"), name), out);
+    }
+  };
+  e.write = [](const Config& c, int indent, Doc& out) {
+    out.push_back({indent, "vehicle_profiles:", "", false});
+    for (const auto& [name, vehicle] : c.vehicle_profiles) {
+      out.push_back({indent + 2, name + ":",
+                     "vehicle_length " + encode(to_mm(vehicle.length_m())) + " m, vehicle_width " +
+                         encode(to_mm(vehicle.width_m())) + " m",
+                     false});
+      write_table(vehicle_table(), vehicle, indent + 4, out);
+    }
+  };
+  return e;
+}
+
 }  // namespace
 
 const Table<Config>& config_file_table() {
@@ -492,6 +557,12 @@ const Table<Config>& config_file_table() {
   static const Table<T> t{{
       note<T>("The vehicle the service plans for (base_link = rear-axle centre).", true),
       group("vehicle", &T::vehicle, &vehicle_table, ""),
+      note<T>("Named vehicles a request may ask for (PullOutRequest.vehicle_profile; a scenario's\n"
+              "`vehicle: {profile: bus}`), each with the keys of `vehicle` (a key left out takes its default).\n"
+              "A request may also carry its own dimensions; without either it gets `vehicle`. A file that\n"
+              "has this key replaces these profiles whole.",
+              true),
+      vehicle_profiles_entry(),
       note<T>("Planner parameters. Names follow Autoware's start_planner.param.yaml where the concept is\n"
               "the same; the defaults are that file's.",
               true),

@@ -233,6 +233,8 @@ void read_expectation(MapReader& parent, ScenarioExpectation& out) {
   if (r.read("safe", safe)) out.safe = safe;
   std::int64_t stop_object = 0;
   if (r.read("stops_before_object", stop_object)) out.stops_before_object = stop_object;
+  std::string waits_for;
+  if (r.read("waits_for", waits_for)) out.waits_for = waits_for;
   r.finish();
 }
 
@@ -242,6 +244,57 @@ void set_overrides(const YAML::Node& planner, const StartPlannerParameters& para
   if (!planner.IsMap()) return;
   if (planner["search_priority"].IsDefined()) out.search_priority = params.search_priority;
   if (planner["search_policy"].IsDefined()) out.search_policy = params.search_policy;
+}
+
+// `vehicle:` (at `key`): either `{profile: NAME}` (a profile of the config the request is planned
+// with: the request names it, and the service resolves it) or dimension keys over the base
+// config's vehicle (the request carries them all). `vehicle` gets what the CLI draws.
+void read_vehicle(const YAML::Node& node, const std::string& key, const Config& base, VehicleInfo& vehicle,
+                  PullOutRequest& request, Problems& problems) {
+  if (node.IsMap() && node["profile"].IsDefined()) {
+    const auto name = yaml_fields::to_string(node["profile"], key + ".profile", problems);
+    if (node.size() > 1) {
+      problems.push_back(key + ".profile: give a profile or the vehicle's dimensions, not both" +
+                         yaml_fields::where(node));
+    }
+    if (!name) return;
+    request.vehicle_profile = *name;
+    const auto it = base.vehicle_profiles.find(*name);
+    if (it != base.vehicle_profiles.end()) vehicle = it->second;  // else the planner rejects the name
+    return;
+  }
+  apply_vehicle_info(node, key, vehicle, problems);
+  request.vehicle = vehicle;
+}
+
+// `fleet:`: the other vehicles, each {vehicle_id, start, goal, start_velocity, vehicle} on this
+// scenario's lanes and objects.
+void read_fleet(MapReader& root, const Config& base, Scenario& s, Problems& problems) {
+  const YAML::Node list = root.get("fleet");
+  if (!list.IsSequence()) {
+    problems.push_back("fleet: expected a list of vehicles" + yaml_fields::where(list));
+    return;
+  }
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string key = yaml_fields::indexed("fleet", i);
+    MapReader r(list[i], key, problems);
+    if (!r.valid()) continue;
+    PullOutRequest other = s.request;
+    other.vehicle_profile.clear();
+    other.vehicle.reset();
+    if (!r.read("vehicle_id", other.vehicle_id)) problems.push_back(r.key_path("vehicle_id") + ": required");
+    if (other.vehicle_id == s.request.vehicle_id) {
+      problems.push_back(r.key_path("vehicle_id") + ": '" + other.vehicle_id + "' is this scenario's own vehicle");
+    }
+    other.ego_pose = read_pose(r, "start", true);
+    other.ego_velocity_mps = 0.0;
+    r.read("start_velocity", other.ego_velocity_mps);
+    other.goal_pose = read_pose(r, "goal", true);
+    VehicleInfo vehicle = base.vehicle;
+    if (r.has("vehicle")) read_vehicle(r.get("vehicle"), r.key_path("vehicle"), base, vehicle, other, problems);
+    r.finish();
+    s.fleet.push_back(std::move(other));
+  }
 }
 
 }  // namespace
@@ -263,9 +316,7 @@ Scenario load_scenario(const std::string& path, const Config& base) {
   if (request.vehicle_id.empty()) problems.push_back("vehicle_id: must not be empty");
   request.request_id = kScenarioRequestId;
 
-  if (root.has("vehicle")) {
-    apply_vehicle_info(root.get("vehicle"), "vehicle", s.vehicle, problems);
-  }
+  if (root.has("vehicle")) read_vehicle(root.get("vehicle"), "vehicle", base, s.vehicle, request, problems);
   std::string map_file;
   if (root.read("map", map_file)) {
     std::filesystem::path file(map_file);
@@ -337,6 +388,7 @@ Scenario load_scenario(const std::string& path, const Config& base) {
     problems.push_back("deadline_ms: must be >= 0 (0 = the default)");
   }
   if (root.has("expect")) read_expectation(root, s.expect);
+  if (root.has("fleet")) read_fleet(root, base, s, problems);
   root.finish();
 
   if (!problems.empty()) throw ConfigError(path, std::move(problems));

@@ -66,7 +66,7 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
     : config_(config),
       metrics_(make_metrics(config)),
       dds_(config.dds),
-      planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
+      planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map), config.vehicle_profiles),
       registry_(planner_, dds_, registry_options(config.service, metrics_.get())) {
   health_.config_loaded = true;  // load_config validated it
   health_.dds_ready = true;      // DdsEdge throws unless the participant and every endpoint exist

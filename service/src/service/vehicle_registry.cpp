@@ -139,6 +139,10 @@ void VehicleRegistry::forget(Slot& slot, const std::string& vehicle_id, Eviction
     std::lock_guard<std::mutex> publishing(slot.publish_mutex);
     outbox_.forget_vehicle(vehicle_id);
   }
+  {
+    std::lock_guard<std::mutex> lock(fleet_mutex_);
+    fleet_.remove(vehicle_id);
+  }
   evicted_count_.fetch_add(1);
   if (options_.on_evicted) options_.on_evicted(static_cast<int>(reason));
   spdlog::info("vehicle '{}' evicted: {}; idle {:.1f} s, last request {} in state {}", vehicle_id, to_string(reason),
@@ -180,8 +184,33 @@ void VehicleRegistry::reject_full(const PullOutRequest& request) {
   }
 }
 
+void VehicleRegistry::refresh_fleet(const Slot& slot, const std::string& vehicle_id) {
+  std::optional<ExecutingPath> executing = slot.evicted ? std::nullopt : slot.session.executing();
+  std::lock_guard<std::mutex> lock(fleet_mutex_);
+  if (executing) {
+    fleet_.update(std::move(*executing));
+  } else {
+    fleet_.remove(vehicle_id);
+  }
+}
+
+void VehicleRegistry::add_fleet_objects(PlanningJob& job) {
+  std::vector<FleetObstacle> others;
+  {
+    std::lock_guard<std::mutex> lock(fleet_mutex_);
+    if (fleet_.size() == 0) return;
+    others = fleet_.obstacles_for(job.request.vehicle_id, job.request.ego_pose, options_.fleet_radius_m);
+  }
+  // Within the request limit: the request was validated with its own objects.
+  for (FleetObstacle& other : others) {
+    if (job.request.objects.size() >= planner_.limits().max_objects) break;
+    job.request.objects.push_back(std::move(other.object));
+  }
+}
+
 std::optional<PlanningJob> VehicleRegistry::settle(Slot& slot, std::unique_lock<std::mutex>& lock,
                                                    SessionEffects effects, const std::string& vehicle_id) {
+  refresh_fleet(slot, vehicle_id);
   std::optional<PlanningJob> job;
   if (effects.cancel_search && slot.cancel) {
     slot.cancel->store(true);
@@ -252,7 +281,9 @@ std::optional<PlanningJob> VehicleRegistry::on_request(PullOutRequest request,
     spdlog::info("vehicle '{}' request {}: {}", vehicle_id, request_id, effects.note);
     effects.note.clear();
   }
-  return settle(*slot, lock, std::move(effects), vehicle_id);
+  std::optional<PlanningJob> job = settle(*slot, lock, std::move(effects), vehicle_id);
+  if (job) add_fleet_objects(*job);
+  return job;
 }
 
 void VehicleRegistry::on_result(const PlanningJob& job, const PlanningResult& result) {
@@ -287,7 +318,12 @@ void VehicleRegistry::on_progress(const ExecutionProgress& progress) {
   std::unique_lock<std::mutex> lock(slot->mutex);
   if (slot->evicted) return;
   slot->progress_alive = true;
-  SessionEffects effects = slot->session.on_progress(progress, options_.clock());
+  std::vector<FleetObstacle> fleet;
+  {
+    std::lock_guard<std::mutex> fleet_lock(fleet_mutex_);
+    if (fleet_.size() > 0) fleet = fleet_.obstacles_for(progress.vehicle_id, progress.pose, options_.fleet_radius_m);
+  }
+  SessionEffects effects = slot->session.on_progress(progress, options_.clock(), fleet);
   if (effects.status) {
     const PullOutStatus& s = *effects.status;
     spdlog::info("vehicle '{}' request {}: {} segment {}/{}{}{}", progress.vehicle_id, s.request_id, to_string(s.state),

@@ -25,6 +25,13 @@
 // the session and calls Outbox::forget_vehicle (unregisters the vehicle's path and status
 // instances) after any of its samples in flight; each is logged with the reason and idle time.
 // A departed vehicle that still sends progress is never idle, so never evicted.
+//
+// Vehicles that see each other: the registry keeps a FleetBoard of every vehicle driving a path
+// (departed, not completed), refreshed whenever a session's effects are settled and cleared on
+// eviction. Each progress sample's session gets the other vehicles' executing paths near it
+// (FleetBoard::obstacles_for) for its departure and safety rules, and each search gets them as
+// objects (their bodies and timed predicted motion). Progress samples are dispatched on one
+// thread, so two vehicles never decide to depart at the same instant without seeing each other.
 #pragma once
 
 #include <atomic>
@@ -41,6 +48,7 @@
 
 #include "pullout/model/types.hpp"
 #include "pullout/pipeline/start_planner.hpp"
+#include "pullout/session/fleet.hpp"
 #include "pullout/session/vehicle_session.hpp"
 #include "service/outbox.hpp"
 #include "service/planning_queue.hpp"
@@ -60,6 +68,9 @@ struct RegistryOptions {
   double session_idle_timeout_s{300.0};
   // Sessions held at once (>= 1).
   std::size_t max_vehicles{2048};
+  // [m] Vehicles that see each other: another vehicle's executing path counts for a vehicle when
+  // it comes this close to the vehicle's pose (bounds the work per sample).
+  double fleet_radius_m{200.0};
   // The registry's time (sessions, idle times); tests inject a fake. Empty: steady_clock::now.
   std::function<VehicleSession::Clock::time_point()> clock;
   // Observers for statistics (the service's metrics); empty: none. Called on the publishing
@@ -142,8 +153,18 @@ class VehicleRegistry {
   std::optional<PlanningJob> settle(Slot& slot, std::unique_lock<std::mutex>& lock, SessionEffects effects,
                                     const std::string& vehicle_id);
 
+  // The vehicle's entry on the fleet board from its session (caller holds slot.mutex).
+  void refresh_fleet(const Slot& slot, const std::string& vehicle_id);
+  // The other vehicles' executing paths as objects of a search about to run (before departure
+  // they count in planning: their bodies as obstacles, their motion predicted).
+  void add_fleet_objects(PlanningJob& job);
+
   const StartPlanner& planner_;
   Outbox& outbox_;
+  // Vehicles that see each other: every vehicle driving a path (pullout/session/fleet.hpp). Locked
+  // after a slot's mutex, never before one.
+  mutable std::mutex fleet_mutex_;
+  FleetBoard fleet_;
   RegistryOptions options_;
   mutable std::mutex mutex_;  // guards vehicles_ (the map, not the sessions)
   std::unordered_map<std::string, std::shared_ptr<Slot>> vehicles_;

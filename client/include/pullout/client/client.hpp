@@ -139,6 +139,12 @@ struct ClientOptions {
   // send() (>= 0; zero: never re-sent). See "Re-sending and a lost service" above.
   std::chrono::milliseconds resend_period{1000};
   std::chrono::milliseconds resend_window{10000};
+  // The vehicle this client plans for, put into every request that names none of its own
+  // (PullOutRequest::vehicle_profile, ::vehicle): a profile of the service's config ("bus"), or
+  // its own dimensions, or neither (the service's configured vehicle). The service checks them; a
+  // bad one is rejected naming the field ("vehicle_profile: unknown profile ...").
+  std::string vehicle_profile;
+  std::optional<VehicleInfo> vehicle;
 };
 
 // A DDS participant shared by many Clients (see "Many vehicles on one participant" above).

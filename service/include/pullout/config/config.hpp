@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "pullout/pipeline/parameters.hpp"
+#include "pullout/pipeline/start_planner.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 
 namespace YAML {
@@ -90,8 +91,32 @@ struct ObservabilityConfig {
   std::string on_duplicate_service{"warn"};  // one of kDuplicatePolicies
 };
 
+// The shipped vehicle profiles: a car (the default vehicle), a van and a 12 m bus. Dimensions are
+// typical of their class (the bus: 5.9 m wheel base, 2.55 m wide, 7.0 m minimum turning radius of
+// the rear axle).
+inline VehicleProfiles default_vehicle_profiles() {
+  VehicleInfo van;
+  van.wheel_base_m = 3.665;
+  van.wheel_tread_m = 1.73;
+  van.front_overhang_m = 0.9;
+  van.rear_overhang_m = 1.35;
+  van.left_overhang_m = 0.15;
+  van.right_overhang_m = 0.15;
+  van.max_steer_angle_rad = 0.62;
+  VehicleInfo bus;
+  bus.wheel_base_m = 5.9;
+  bus.wheel_tread_m = 2.15;
+  bus.front_overhang_m = 2.6;
+  bus.rear_overhang_m = 3.5;
+  bus.left_overhang_m = 0.2;
+  bus.right_overhang_m = 0.2;
+  bus.max_steer_angle_rad = 0.70;
+  return {{"car", VehicleInfo{}}, {"van", van}, {"bus", bus}};
+}
+
 struct Config {
   VehicleInfo vehicle;
+  VehicleProfiles vehicle_profiles{default_vehicle_profiles()};
   StartPlannerParameters start_planner;
   ServiceConfig service;
   DdsConfig dds;

@@ -1,6 +1,8 @@
 // Scenario files: one YAML format for the CLI, the tests and the benchmarks (see DESIGN.md).
 //
-//   vehicle: {wheel_base: 2.79, ...}          # optional, overrides the config's vehicle
+//   vehicle: {wheel_base: 2.79, ...}          # optional, overrides the config's vehicle (and the
+//                                             # request carries it), or {profile: bus}: a profile of
+//                                             # the config's vehicle_profiles, named in the request
 //   map: ../maps/straight_shoulder.osm        # Lanelet2 map, relative to this file ...
 //   route: [101, 102, 103]                    # ... and the road lanelets to pull out onto, or
 //                                             # Autoware route segments: [{preferred: 101,
@@ -30,15 +32,22 @@
 //   deadline_ms: 200                          # optional
 //   vehicle_id: demo-1                        # optional
 //   description: "..."                        # optional, free text
+//   fleet:                                    # optional: other vehicles on the same lanes and
+//     - {vehicle_id: fleet-a, start: {x: 20, y: 3.25, yaw_deg: 0}, goal: {x: 90, y: 0, yaw_deg: 0},
+//        vehicle: {profile: van}}             #   objects, planned, approved and executing (in this
+//                                             #   order) when this vehicle asks and departs
 //   expect: {found: true, planner: shift, safe: true}   # optional, used by tests; safe: the
 //                                             # safety verdict at the start, before departure;
 //                                             # stops_before_object: 7, the published path stops
-//                                             # before object 7 beyond the end pose
+//                                             # before object 7 beyond the end pose;
+//                                             # waits_for: fleet-a, the approved vehicle waits for
+//                                             # that fleet vehicle ("": departs at once)
 #pragma once
 
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "pullout/config/config.hpp"
 #include "pullout/model/types.hpp"
@@ -56,6 +65,8 @@ struct ScenarioExpectation {
   // The published path is cut and stops (velocity 0) before this static object, beyond the end
   // pose (`stops_before_object: 7`).
   std::optional<std::int64_t> stops_before_object;
+  // With `fleet:`: the vehicle the approved vehicle waits for while the fleet drives ("": none).
+  std::optional<std::string> waits_for;
 };
 
 struct Scenario {
@@ -67,6 +78,9 @@ struct Scenario {
   VehicleInfo vehicle;                    // base config's vehicle with the scenario's overrides
   StartPlannerParameters parameters;      // base config's parameters with `planner:` applied
   ScenarioExpectation expect;
+  // `fleet:`: the other vehicles' requests (this scenario's lanes and objects, their own id, start,
+  // goal and vehicle), executing their paths in this order before `request` is planned.
+  std::vector<PullOutRequest> fleet;
 };
 
 // Loads a scenario on top of `base` (vehicle and start_planner come from it unless overridden),

@@ -9,6 +9,8 @@
 // name says otherwise.
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -114,6 +116,58 @@ struct RouteSegment {
   std::vector<std::int64_t> primitive_ids;
 };
 
+// A vehicle's dimensions and steering limit, in its base_link frame (the rear-axle centre, +x
+// forward). Names are Autoware's vehicle_info keys with a unit suffix (wheel_base -> wheel_base_m).
+struct VehicleInfo {
+  double wheel_base_m{2.79};
+  double wheel_tread_m{1.64};
+  double front_overhang_m{1.0};
+  double rear_overhang_m{1.1};
+  double left_overhang_m{0.128};
+  double right_overhang_m{0.128};
+  double max_steer_angle_rad{0.70};
+
+  double base_to_front_m() const { return wheel_base_m + front_overhang_m; }
+  double base_to_rear_m() const { return rear_overhang_m; }
+  double length_m() const { return base_to_front_m() + base_to_rear_m(); }  // Autoware's vehicle_length
+  double base_to_left_m() const { return wheel_tread_m / 2.0 + left_overhang_m; }
+  double base_to_right_m() const { return wheel_tread_m / 2.0 + right_overhang_m; }
+  double width_m() const { return base_to_left_m() + base_to_right_m(); }  // Autoware's vehicle_width
+  // Minimum turning radius of the rear-axle centre at max steer [m].
+  double min_turning_radius_m() const { return wheel_base_m / std::tan(max_steer_angle_rad); }
+
+  bool operator==(const VehicleInfo& o) const {
+    return wheel_base_m == o.wheel_base_m && wheel_tread_m == o.wheel_tread_m &&
+           front_overhang_m == o.front_overhang_m && rear_overhang_m == o.rear_overhang_m &&
+           left_overhang_m == o.left_overhang_m && right_overhang_m == o.right_overhang_m &&
+           max_steer_angle_rad == o.max_steer_angle_rad;
+  }
+  bool operator!=(const VehicleInfo& o) const { return !(*this == o); }
+};
+
+// Each VehicleInfo member with its Autoware key, unit and allowed range (closed): the one spelling
+// that the config file's `vehicle` and `vehicle_profiles` and a request's own vehicle are checked
+// against. max_steer_angle stays below pi/2 so the turning radius is positive and finite.
+struct VehicleField {
+  const char* key;
+  double VehicleInfo::*member;
+  const char* unit;
+  double min;
+  double max;
+  const char* comment;
+};
+inline constexpr std::array<VehicleField, 7> kVehicleFields{{
+    {"wheel_base", &VehicleInfo::wheel_base_m, "m", 0.1, 20.0, "front to rear axle"},
+    {"wheel_tread", &VehicleInfo::wheel_tread_m, "m", 0.1, 5.0, "distance between the left and right wheels"},
+    {"front_overhang", &VehicleInfo::front_overhang_m, "m", 0.0, 10.0, "front axle to the front bumper"},
+    {"rear_overhang", &VehicleInfo::rear_overhang_m, "m", 0.0, 10.0, "rear axle to the rear bumper"},
+    {"left_overhang", &VehicleInfo::left_overhang_m, "m", 0.0, 2.0,
+     "left wheel outer face to the left side of the body"},
+    {"right_overhang", &VehicleInfo::right_overhang_m, "m", 0.0, 2.0,
+     "right wheel outer face to the right side of the body"},
+    {"max_steer_angle", &VehicleInfo::max_steer_angle_rad, "rad", 0.01, 1.5, ""},
+}};
+
 struct PullOutRequest {
   std::string vehicle_id;
   std::uint64_t request_id{0};
@@ -128,6 +182,12 @@ struct PullOutRequest {
   std::optional<OccupancyGrid> occupancy_grid;
   PlannerOverrides overrides;
   double deadline_ms{0.0};  // [ms] planning budget; 0 = the service's default
+  // The vehicle to plan for: a profile of the service's config (vehicle_profiles, e.g. "bus"), or
+  // its own dimensions (`vehicle`), not both. Neither: the service's configured vehicle. Checked
+  // like the config's vehicle (kVehicleFields); a problem names the field ("vehicle.wheel_base",
+  // "vehicle_profile").
+  std::string vehicle_profile;
+  std::optional<VehicleInfo> vehicle;
 };
 
 // Whether the request names a route on the map (ids or segments).
@@ -236,6 +296,9 @@ struct PullOutStatus {
   // A found path: how the published path ends, e.g. "stops 2.01 m before object 7, 20.9 m beyond
   // the end pose" (the path's velocity is 0 there), or where it ends when nothing is in the way.
   std::string path_end;
+  // Vehicles that see each other: the vehicle (its id) whose executing path crosses this one, so
+  // that this vehicle waits (kWaitingSafety before departure, a stop after); empty otherwise.
+  std::string waiting_for_vehicle_id;
 };
 
 // A problem with a request: the field (e.g. "lanes[2].left_bound[5].x", "ego_pose.orientation")

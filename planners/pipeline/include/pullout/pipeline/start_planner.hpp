@@ -30,6 +30,8 @@
 // the planning horizon (...)").
 #pragma once
 
+#include <cstddef>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +54,7 @@ std::string format_issues(const std::vector<RequestIssue>& issues);
 struct PlannedWorld {
   std::vector<Lane> lanes;
   std::vector<Object> objects;
+  VehicleInfo vehicle;  // the vehicle planned for (StartPlanner::vehicle_for)
 };
 
 struct PlanningResult {
@@ -86,12 +89,18 @@ struct PlanningResult {
 // no plan.
 double planning_horizon_m(const StartPlannerParameters& parameters, const VehicleInfo& vehicle);
 
+// Named vehicles a request may ask for (PullOutRequest::vehicle_profile), e.g. "car", "van", "bus".
+using VehicleProfiles = std::map<std::string, VehicleInfo>;
+// The longest vehicle_profile [bytes] looked up; a longer one is rejected unread.
+inline constexpr std::size_t kMaxVehicleProfileBytes = 255;
+
 class StartPlanner {
  public:
-  // Parameters must be valid (as load_config / check_config accept them). `map` may be null (no
-  // map: only inline lanes are accepted).
+  // Parameters, vehicle and profiles must be valid (as load_config / check_config accept them).
+  // `map` may be null (no map: only inline lanes are accepted). `vehicle` is the default vehicle;
+  // a request may name one of `profiles` or carry its own dimensions (vehicle_for).
   StartPlanner(VehicleInfo vehicle, StartPlannerParameters parameters, RequestLimits limits = {},
-               std::shared_ptr<const LaneletMap> map = nullptr);
+               std::shared_ptr<const LaneletMap> map = nullptr, VehicleProfiles profiles = {});
 
   // Plans for one request within `stop` (checked before every attempt and inside every search).
   // Applies the request's overrides (search_priority, search_policy) to a copy of the parameters.
@@ -101,7 +110,17 @@ class StartPlanner {
   // Only the validation step of plan(): every problem of the request, empty when valid.
   std::vector<RequestIssue> validate(const PullOutRequest& request) const;
 
+  // The request's vehicle problems: both a profile and dimensions, an unknown profile
+  // ("vehicle_profile: unknown profile 'x' (the service has bus, car, van)"), each dimension outside
+  // kVehicleFields' range ("vehicle.wheel_base: must be in [0.1, 20] m, got 0"). Part of validate().
+  std::vector<RequestIssue> vehicle_issues(const PullOutRequest& request) const;
+  // The vehicle a (valid) request is planned for: its own dimensions, else its profile, else the
+  // default vehicle.
+  VehicleInfo vehicle_for(const PullOutRequest& request) const;
+
+  // The default vehicle.
   const VehicleInfo& vehicle() const { return vehicle_; }
+  const VehicleProfiles& profiles() const { return profiles_; }
   const StartPlannerParameters& parameters() const { return parameters_; }
   const RequestLimits& limits() const { return limits_; }
   const std::shared_ptr<const LaneletMap>& map() const { return map_; }
@@ -109,12 +128,14 @@ class StartPlanner {
  private:
   bool grid_only_allowed() const;
   // A request with a grid and no lanes: hybrid A* straight to the goal pose.
-  PlanningResult plan_grid_only(const PullOutRequest& request, const StopCondition& stop) const;
+  PlanningResult plan_grid_only(const PullOutRequest& request, const VehicleInfo& vehicle,
+                                const StopCondition& stop) const;
 
   VehicleInfo vehicle_;
   StartPlannerParameters parameters_;
   RequestLimits limits_;
   std::shared_ptr<const LaneletMap> map_;
+  VehicleProfiles profiles_;
 };
 
 }  // namespace pullout

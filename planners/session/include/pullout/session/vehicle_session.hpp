@@ -62,6 +62,7 @@
 #include "pullout/model/types.hpp"
 #include "pullout/pipeline/start_planner.hpp"
 #include "pullout/safety/safety_monitor.hpp"
+#include "pullout/session/fleet.hpp"
 
 namespace pullout {
 
@@ -69,6 +70,9 @@ struct SessionOptions {
   // [s] A departed vehicle with no accepted progress sample for this long is told to stop
   // (kWaitingSafety, "odometry lost"). 0 disables the rule.
   double progress_timeout_s{2.0};
+  // [m] Vehicles that see each other (fleet.hpp): the ego's footprint is pushed out this much on
+  // each side when its remaining path is checked against another vehicle's.
+  double fleet_clearance_m{0.5};
 };
 
 // [s] How far a progress stamp may run ahead of the service's clock since the previous accepted
@@ -114,8 +118,12 @@ class VehicleSession {
   SessionEffects on_result(std::uint64_t sequence, const PlanningResult& result, Clock::time_point now);
   // The search `sequence` failed with an exception (a bug): kNoPath with the reason.
   SessionEffects on_search_failed(std::uint64_t sequence, const std::string& what, Clock::time_point now);
-  // One odometry sample of this vehicle.
-  SessionEffects on_progress(const ExecutionProgress& progress, Clock::time_point now);
+  // One odometry sample of this vehicle. `fleet`: the other vehicles driving their paths
+  // (FleetBoard::obstacles_for): before departure the vehicle waits (kWaitingSafety) while its
+  // path crosses one of them, after departure it gets a stop; the status names that vehicle
+  // (waiting_for_vehicle_id) and the stop reason does ("waiting for vehicle 'A': ...").
+  SessionEffects on_progress(const ExecutionProgress& progress, Clock::time_point now,
+                             const std::vector<FleetObstacle>& fleet = {});
   // Time passes with no input (called periodically).
   SessionEffects on_time(Clock::time_point now);
   // The found path of `request_id` could not be published (a transport failure): the vehicle
@@ -123,6 +131,9 @@ class VehicleSession {
   SessionEffects on_path_undeliverable(std::uint64_t request_id);
 
   const PullOutStatus& status() const { return status_; }
+  // The path this vehicle drives, for the other vehicles: set while it has departed on a found
+  // path and not completed it (executing, or stopped on it for safety).
+  std::optional<ExecutingPath> executing() const;
   // The sequence of the search whose result is awaited (0: none).
   std::uint64_t pending_search() const { return pending_; }
   // When the session last received anything from its vehicle.
@@ -145,7 +156,8 @@ class VehicleSession {
   SessionEffects reject(std::uint64_t request_id, const std::vector<RequestIssue>& issues);
   // The departure and safety rules for one accepted sample; fills `out` and returns whether the
   // status changed.
-  bool apply_departure_rules(const ExecutionProgress& progress, Clock::time_point now, SessionEffects& out);
+  bool apply_departure_rules(const ExecutionProgress& progress, Clock::time_point now,
+                             const std::vector<FleetObstacle>& fleet, SessionEffects& out);
   // Re-publishes the path with a feasible stop from the vehicle's last known motion.
   void insert_stop(const Pose2& pose, double velocity, const std::string& reason, SessionEffects& out);
   PullOutStatus make_status(std::uint64_t request_id, ExecutionState state) const;
@@ -172,6 +184,7 @@ class VehicleSession {
   // The found path being followed (as planned), its safety monitor and what was published of it.
   std::optional<PullOutPath> path_;
   std::optional<SafetyMonitor> safety_;
+  VehicleInfo planned_vehicle_;  // the vehicle path_ was planned for (its own, a profile's, the default)
   PullOutPath published_;
   bool stop_inserted_{false};
   // Turn signal and its start (stamp, service time) carried from a path a same-goal re-plan replaces.
