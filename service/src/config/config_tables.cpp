@@ -428,6 +428,9 @@ const Table<ServiceConfig>& service_table() {
               "start-up): each session holds one instance on the path and on the status writer."),
       field("session_idle_timeout_s", &T::session_idle_timeout_s, "s", in(0.0, 86400.0), "0 = never by time"),
       field("max_vehicles", &T::max_vehicles, "", in(1, 1000000), "sessions held at once"),
+      field("state_dir", &T::state_dir, "", AnyValue{},
+            "every vehicle's request, path and status kept here and read back at start-up (restart without "
+            "loss); relative to this file; empty = off"),
       note<T>("Size limits of one request; a larger request is rejected with the field named."),
       group("limits", &T::limits, &limits_table, ""),
   }};

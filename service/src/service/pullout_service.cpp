@@ -60,14 +60,21 @@ std::unique_ptr<ServiceMetrics> make_metrics(const Config& config) {
   return std::make_unique<ServiceMetrics>(kVersionString);
 }
 
+std::unique_ptr<StateJournal> make_journal(const Config& config, Outbox& next) {
+  if (config.service.state_dir.empty()) return nullptr;
+  return std::make_unique<StateJournal>(config.service.state_dir, next);
+}
+
 }  // namespace
 
 PulloutService::PulloutService(const Config& config, std::shared_ptr<const LaneletMap> map)
     : config_(config),
       metrics_(make_metrics(config)),
       dds_(config.dds),
+      journal_(make_journal(config, dds_)),
       planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
-      registry_(planner_, dds_, registry_options(config.service, metrics_.get())) {
+      registry_(planner_, journal_ ? static_cast<Outbox&>(*journal_) : dds_,
+                registry_options(config.service, metrics_.get())) {
   health_.config_loaded = true;  // load_config validated it
   health_.dds_ready = true;      // DdsEdge throws unless the participant and every endpoint exist
   // Every session holds one instance on the path and on the status writer, and a vehicle that is
@@ -93,6 +100,7 @@ PulloutService::~PulloutService() { stop(); }
 
 void PulloutService::start() {
   if (dispatcher_.joinable() || stopping_) return;
+  if (journal_) restore_from_journal();
   dispatcher_ = std::thread([this] { dispatch_loop(); });
 }
 
@@ -108,6 +116,35 @@ void PulloutService::stop() {
     if (queue_) queue_->stop();
     http_.reset();
   });
+}
+
+void PulloutService::restore_from_journal() {
+  const auto t0 = std::chrono::steady_clock::now();
+  JournalLoad loaded = journal_->load(config_.service.session_idle_timeout_s);
+  for (const std::string& problem : loaded.problems) spdlog::warn("state journal: {} (ignored)", problem);
+  for (JournalEntry& e : loaded.entries) {
+    SessionSnapshot snapshot;
+    if (e.request) snapshot.request = std::move(*e.request);
+    snapshot.path = std::move(e.path);
+    snapshot.status = std::move(e.status);
+    restore(snapshot, e.request ? e.request_issues : std::vector<RequestIssue>{{"request", "not in the journal"}});
+  }
+  spdlog::info("state journal {}: {} vehicle(s) restored, {} file(s) ignored in {:.1f} ms", config_.service.state_dir,
+               loaded.entries.size(), loaded.problems.size(),
+               std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+}
+
+void PulloutService::restore(const SessionSnapshot& snapshot, const std::vector<RequestIssue>& request_issues) {
+  std::shared_ptr<const PlannedWorld> world;
+  std::vector<RequestIssue> issues = request_issues;
+  if (issues.empty()) world = planner_.planned_world(snapshot.request, issues);
+  if (!world && has_path(snapshot.status.state)) {
+    spdlog::warn("vehicle '{}' request {}: no world for the safety check ({}: {}): the vehicle must send it again",
+                 snapshot.status.vehicle_id, snapshot.status.request_id, issues.empty() ? "?" : issues.front().field,
+                 issues.empty() ? "?" : issues.front().problem);
+  }
+  std::optional<PlanningJob> job = registry_.restore(snapshot, std::move(world));
+  if (job) queue_->push(std::move(*job));
 }
 
 double PulloutService::effective_deadline_ms(double requested_ms) const {
@@ -250,6 +287,7 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
                  sample.vehicle_id().size(), kMaxVehicleIdBytes);
     return;
   }
+  if (journal_) journal_->on_request(sample);
   std::vector<RequestIssue> issues;
   PullOutRequest request = idl::from_msg(sample, issues);
   if (!issues.empty()) {

@@ -30,6 +30,7 @@
 #include "pullout/pipeline/start_planner.hpp"
 #include "service/dds_edge.hpp"
 #include "service/planning_queue.hpp"
+#include "service/state_journal.hpp"
 #include "service/vehicle_registry.hpp"
 
 namespace eprosima::fastdds::dds {
@@ -83,12 +84,18 @@ class PulloutService {
   void handle_request(const msg::PullOutRequest& sample);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
+  // service.state_dir: every vehicle of the journal restored (before the dispatcher starts).
+  void restore_from_journal();
+  // A snapshot's session rebuilt in the registry, its search (if any) queued.
+  void restore(const SessionSnapshot& snapshot, const std::vector<RequestIssue>& request_issues);
 
   Config config_;
   // First: the registry's and the queue's observers use them until those are gone.
   HealthState health_;
   std::unique_ptr<ServiceMetrics> metrics_;  // null when observability.metrics is off
   DdsEdge dds_;
+  // service.state_dir: journals what the registry publishes, then hands it to dds_ (null: off).
+  std::unique_ptr<StateJournal> journal_;
   StartPlanner planner_;
   VehicleRegistry registry_;
   std::atomic<bool> stopping_{false};

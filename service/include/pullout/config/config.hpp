@@ -65,6 +65,10 @@ struct ServiceConfig {
   // Sessions held at once; when full, the least recently active idle one makes room, and when
   // none is idle a new vehicle is rejected. At most the DDS profiles' max_instances.
   std::size_t max_vehicles{2048};
+  // A directory where every vehicle's latest request, path and status are kept (one file each,
+  // replaced atomically), read back at start-up: a killed service restarts without losing its
+  // vehicles. Relative to the config file; empty: off.
+  std::string state_dir;
 };
 
 struct MapConfig {

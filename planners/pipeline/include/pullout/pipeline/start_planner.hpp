@@ -101,6 +101,12 @@ class StartPlanner {
   // Only the validation step of plan(): every problem of the request, empty when valid.
   std::vector<RequestIssue> validate(const PullOutRequest& request) const;
 
+  // The world plan() plans `request` on (its lanes, inline or picked on the map, and its objects),
+  // without planning: what a session restored from a snapshot (VehicleSession::restore) checks
+  // safety on. Null with `issues` filled when the request is not valid.
+  std::shared_ptr<const PlannedWorld> planned_world(const PullOutRequest& request,
+                                                    std::vector<RequestIssue>& issues) const;
+
   const VehicleInfo& vehicle() const { return vehicle_; }
   const StartPlannerParameters& parameters() const { return parameters_; }
   const RequestLimits& limits() const { return limits_; }
