@@ -70,7 +70,7 @@ std::unique_ptr<StateJournal> make_journal(const Config& config, Outbox& next) {
 PulloutService::PulloutService(const Config& config, std::shared_ptr<const LaneletMap> map)
     : config_(config),
       metrics_(make_metrics(config)),
-      dds_(config.dds),
+      dds_(config.dds, config.service.replica),
       journal_(make_journal(config, dds_)),
       planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map)),
       registry_(planner_, journal_ ? static_cast<Outbox&>(*journal_) : dds_,
@@ -87,6 +87,7 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
                         " of the DDS profiles in " + describe_profiles(config.dds) +
                         ": lower max_vehicles or raise max_instances");
   }
+  if (config.service.replica.enabled) shadows_ = std::make_unique<ReplicaShadows>(config.service.max_vehicles);
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
   health_.workers_running = true;
   if (metrics_) {
@@ -162,6 +163,17 @@ void PulloutService::dispatch_loop() {
   waitset.attach_condition(progress);
   waitset.attach_condition(shutdown_);
   if (dds_.secure()) waitset.attach_condition(dds_.discovery_condition());
+  dds::StatusCondition* replica_paths = nullptr;
+  dds::StatusCondition* replica_statuses = nullptr;
+  if (shadows_) {
+    replica_paths = &dds_.replica_path_reader()->get_statuscondition();
+    replica_statuses = &dds_.replica_status_reader()->get_statuscondition();
+    replica_paths->set_enabled_statuses(dds::StatusMask::data_available());
+    replica_statuses->set_enabled_statuses(dds::StatusMask::data_available());
+    waitset.attach_condition(*replica_paths);
+    waitset.attach_condition(*replica_statuses);
+    waitset.attach_condition(dds_.replica_condition());
+  }
   spdlog::debug("dispatcher running");
   health_.beat();
 
@@ -177,6 +189,10 @@ void PulloutService::dispatch_loop() {
     health_.beat();
     dds_.prepare_discovered_vehicles();
     // Both readers are drained on every wake-up: cheap when empty, and it cannot miss data.
+    if (shadows_) {
+      take_replica_samples();
+      take_over_departed();
+    }
     take_requests();
     take_progress();
     const auto now = std::chrono::steady_clock::now();
@@ -202,6 +218,11 @@ void PulloutService::dispatch_loop() {
   waitset.detach_condition(progress);
   waitset.detach_condition(shutdown_);
   if (dds_.secure()) waitset.detach_condition(dds_.discovery_condition());
+  if (shadows_) {
+    waitset.detach_condition(*replica_paths);
+    waitset.detach_condition(*replica_statuses);
+    waitset.detach_condition(dds_.replica_condition());
+  }
   spdlog::debug("dispatcher stopped");
 }
 
@@ -215,6 +236,13 @@ void PulloutService::take_requests() {
       if (info.valid_data) {
         if (!sender_allowed(info, sample.vehicle_id(), "request")) continue;
         request_instances_[info.instance_handle] = sample.vehicle_id();
+        if (shadows_ && !serving(sample.vehicle_id())) {
+          // Another replica serves it: kept for a takeover (decoded and validated then).
+          std::vector<RequestIssue> issues;
+          PullOutRequest request = idl::from_msg(sample, issues);
+          if (issues.empty() && sample.vehicle_id().size() <= kMaxVehicleIdBytes) shadows_->keep_request(request);
+          continue;
+        }
         handle_request(sample);
       } else {
         instance_gone(request_instances_, info, VehicleInput::kRequest);
@@ -236,6 +264,7 @@ void PulloutService::take_progress() {
       if (info.valid_data) {
         if (!sender_allowed(info, sample.vehicle_id(), "progress")) continue;
         progress_instances_[info.instance_handle] = sample.vehicle_id();
+        if (shadows_ && !registry_.holds(sample.vehicle_id())) continue;  // another replica's vehicle
         handle_progress(sample);
       } else {
         instance_gone(progress_instances_, info, VehicleInput::kProgress);
@@ -243,6 +272,77 @@ void PulloutService::take_progress() {
     } catch (const std::exception& e) {
       spdlog::error("progress sample dropped: {}", e.what());
     }
+  }
+}
+
+bool PulloutService::serving(const std::string& vehicle_id) const {
+  return registry_.holds(vehicle_id) || shadows_->serves(vehicle_id, dds_.self(), dds_.replicas());
+}
+
+void PulloutService::take_replica_samples() {
+  const ParticipantId self = dds_.self();
+  const auto writer_of = [](const dds::SampleInfo& info) {
+    return eprosima::fastrtps::rtps::iHandle2GUID(info.publication_handle).guidPrefix;
+  };
+  // A vehicle another replica speaks for: shadowed; if this replica serves it too (two replicas
+  // decided on different views of who is alive), the one with the smaller GUID prefix yields.
+  const auto note_owner = [&](const std::string& vehicle_id, const ParticipantId& writer) -> ReplicaShadows::Shadow* {
+    if (writer == self) {
+      shadows_->erase(vehicle_id);  // this replica serves it
+      return nullptr;
+    }
+    if (registry_.holds(vehicle_id)) {
+      if (writer < self) return nullptr;  // the other one yields
+      registry_.release(vehicle_id);
+      spdlog::warn("vehicle '{}': another replica serves it too; this one yields", vehicle_id);
+    }
+    ReplicaShadows::Shadow* shadow = shadows_->at(vehicle_id);
+    if (shadow != nullptr) shadow->owner = writer;
+    return shadow;
+  };
+  {
+    msg::PullOutPath sample;
+    dds::SampleInfo info;
+    while (!stopping_ && dds_.replica_path_reader()->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      if (ReplicaShadows::Shadow* s = note_owner(sample.vehicle_id(), writer_of(info))) s->path = idl::from_msg(sample);
+    }
+  }
+  msg::PullOutStatus sample;
+  dds::SampleInfo info;
+  while (!stopping_ && dds_.replica_status_reader()->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data) {
+      // Disposed: the owner evicted the vehicle (not the owner dying: that is no writers).
+      const auto it = replica_status_instances_.find(info.instance_handle);
+      if (it == replica_status_instances_.end()) continue;
+      if (info.instance_state == dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE) shadows_->erase(it->second);
+      if (info.instance_state != dds::NOT_ALIVE_NO_WRITERS_INSTANCE_STATE) replica_status_instances_.erase(it);
+      continue;
+    }
+    replica_status_instances_[info.instance_handle] = sample.vehicle_id();
+    if (ReplicaShadows::Shadow* s = note_owner(sample.vehicle_id(), writer_of(info))) s->status = idl::from_msg(sample);
+  }
+}
+
+void PulloutService::take_over_departed() {
+  for (const ParticipantId& departed : dds_.take_departed_replicas()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const ParticipantId self = dds_.self();
+    const std::vector<ParticipantId> others = dds_.replicas();
+    std::size_t taken = 0;
+    const std::vector<std::string> vehicles = shadows_->owned_by(departed);
+    for (const std::string& vehicle_id : vehicles) {
+      if (!shadows_->serves(vehicle_id, self, others)) continue;  // another replica wins it
+      bool request_known = false;
+      const std::optional<SessionSnapshot> snapshot = shadows_->snapshot(vehicle_id, request_known);
+      shadows_->erase(vehicle_id);
+      if (!snapshot) continue;
+      restore(*snapshot, request_known ? std::vector<RequestIssue>{}
+                                       : std::vector<RequestIssue>{{"request", "not seen by this replica"}});
+      ++taken;
+    }
+    spdlog::info("took over {} of the {} vehicle(s) of the replica that left, in {:.1f} ms", taken, vehicles.size(),
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
 }
 

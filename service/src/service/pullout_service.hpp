@@ -30,6 +30,7 @@
 #include "pullout/pipeline/start_planner.hpp"
 #include "service/dds_edge.hpp"
 #include "service/planning_queue.hpp"
+#include "service/replicas.hpp"
 #include "service/state_journal.hpp"
 #include "service/vehicle_registry.hpp"
 
@@ -73,6 +74,11 @@ class PulloutService {
   void dispatch_loop();
   void take_requests();
   void take_progress();
+  // Replica mode: the other replicas' paths and statuses (shadows), and the vehicles of replicas
+  // that left (taken over when this replica wins them).
+  void take_replica_samples();
+  void take_over_departed();
+  bool serving(const std::string& vehicle_id) const;
   // Whether the sample's writer may speak for vehicle_id (DdsEdge::sender_may_act_for); logs a
   // refusal, rate-limited.
   bool sender_allowed(const eprosima::fastdds::dds::SampleInfo& info, const std::string& vehicle_id, const char* what);
@@ -111,6 +117,9 @@ class PulloutService {
   // Dispatcher thread only.
   InstanceNames request_instances_;
   InstanceNames progress_instances_;
+  // Replica mode (null otherwise): the vehicles other replicas serve. Dispatcher thread only.
+  std::unique_ptr<ReplicaShadows> shadows_;
+  InstanceNames replica_status_instances_;
   // Last: destroyed (workers joined) before the registry and the DDS entities they use.
   std::unique_ptr<PlanningQueue> queue_;
   // After the queue: serves /readyz about everything above; stopped first.
