@@ -328,8 +328,8 @@ SessionEffects VehicleSession::on_time(Clock::time_point now) {
   return out;
 }
 
-SessionEffects VehicleSession::restore(const SessionSnapshot& snapshot, std::shared_ptr<const PlannedWorld> world,
-                                       Clock::time_point now) {
+SessionEffects VehicleSession::restore(const SessionSnapshot& snapshot,
+                                       const std::shared_ptr<const PlannedWorld>& world, Clock::time_point now) {
   const PullOutStatus& st = snapshot.status;
   const PullOutRequest& request = snapshot.request;
   if (st.state == ExecutionState::kPlanning && world && request.request_id == st.request_id) {

@@ -347,7 +347,7 @@ std::optional<PlanningJob> VehicleRegistry::restore(const SessionSnapshot& snaps
   // Alive until its readers say otherwise: a vehicle that never comes back goes by the idle timeout.
   slot->request_alive = true;
   slot->progress_alive = true;
-  SessionEffects effects = slot->session.restore(snapshot, std::move(world), now);
+  SessionEffects effects = slot->session.restore(snapshot, world, now);
   spdlog::info("vehicle '{}' request {}: {}", vehicle_id, snapshot.status.request_id,
                effects.note.empty() ? std::string("restored in state ") + pullout::to_string(snapshot.status.state)
                                     : effects.note);

@@ -140,7 +140,7 @@ class VehicleSession {
   //     found = false and the reason (the vehicle sends its request again);
   //   - any other state: kept as it is.
   // The effects re-publish the path and the status (the same request id and segments).
-  SessionEffects restore(const SessionSnapshot& snapshot, std::shared_ptr<const PlannedWorld> world,
+  SessionEffects restore(const SessionSnapshot& snapshot, const std::shared_ptr<const PlannedWorld>& world,
                          Clock::time_point now);
   // The found path of `request_id` could not be published (a transport failure): the vehicle
   // never got it, so it is not followed (kNoPath with the reason).
