@@ -592,5 +592,96 @@ TEST_F(Session, AnUndeliverablePathIsNotFollowed) {
   EXPECT_FALSE(progress(start_of(*found.path), 0.0, true).status);
 }
 
+// --- restore (a replica taking a vehicle over, a restart) ---
+
+class RestoredSession : public Session {
+ protected:
+  // Plans car_close_ahead, departs and finishes the reverse leg: executing segment 1 of 2.
+  void drive_to_second_segment() {
+    sc_ = scenario("car_close_ahead");
+    use(sc_);
+    sc_.request.vehicle_id = "test";
+    found_ = *plan(sc_.request).path;
+    ASSERT_GE(found_.partial_paths.size(), 2u);
+    progress(start_of(found_), 0.0, true);
+    const Pose2 end0 = end_of_segment(found_, 0);
+    for (int i = 0; i < 12; ++i) progress(end0, 0.0, true);
+    ASSERT_EQ(status().current_path_idx, 1u);
+    ASSERT_EQ(status().state, ExecutionState::kExecuting);
+  }
+  SessionSnapshot snapshot() const { return SessionSnapshot{sc_.request, found_, status()}; }
+  // A new session (another process) restored from `snap`.
+  SessionEffects restore_into_new(const SessionSnapshot& snap, bool with_world = true) {
+    std::vector<RequestIssue> issues;
+    auto world = with_world ? planner_->planned_world(snap.request, issues) : nullptr;
+    EXPECT_TRUE(issues.empty());
+    session_ = std::make_unique<VehicleSession>("test", *planner_);
+    now_ += seconds(1);
+    return session_->restore(snap, world, now_);
+  }
+  Scenario sc_;
+  PullOutPath found_;
+};
+
+TEST_F(RestoredSession, AVehicleInMidManoeuvreKeepsItsPathSegmentAndDeparture) {
+  drive_to_second_segment();
+  const SessionSnapshot snap = snapshot();
+  const SessionEffects e = restore_into_new(snap);
+  ASSERT_TRUE(e.path && e.status);
+  EXPECT_FALSE(e.search);
+  EXPECT_EQ(e.path->request_id, found_.request_id);
+  EXPECT_EQ(e.path->partial_paths.size(), found_.partial_paths.size());
+  EXPECT_TRUE(e.path->found);
+  EXPECT_EQ(e.status->current_path_idx, 1u);
+  EXPECT_TRUE(e.status->departed);
+  EXPECT_EQ(e.status->state, ExecutionState::kExecuting);
+  // The next approved sample on segment 1 keeps it executing there: no second approval, no
+  // prepare time, no restart from segment 0.
+  const auto& seg1 = found_.partial_paths[1].points;
+  const SessionEffects next = progress(seg1[1].pose, 1.0, true);
+  EXPECT_EQ(status().state, ExecutionState::kExecuting);
+  EXPECT_EQ(status().current_path_idx, 1u);
+  EXPECT_TRUE(status().departed);
+  (void)next;
+}
+
+TEST_F(RestoredSession, WithoutTheRequestsWorldNothingMayDrive) {
+  drive_to_second_segment();
+  const SessionEffects e = restore_into_new(snapshot(), false);
+  ASSERT_TRUE(e.path && e.status);
+  EXPECT_FALSE(e.path->found);
+  EXPECT_EQ(e.status->state, ExecutionState::kNoPath);
+  EXPECT_NE(e.status->stop_reason.find("send the request again"), std::string::npos) << e.status->stop_reason;
+  progress(end_of_segment(found_, 0), 0.0, true);
+  EXPECT_NE(status().state, ExecutionState::kExecuting);
+}
+
+TEST_F(RestoredSession, AWaitingVehicleStillNeedsItsApproval) {
+  sc_ = scenario("car_close_ahead");
+  use(sc_);
+  sc_.request.vehicle_id = "test";
+  found_ = *plan(sc_.request).path;
+  ASSERT_EQ(status().state, ExecutionState::kWaitingApproval);
+  const SessionEffects e = restore_into_new(snapshot());
+  ASSERT_TRUE(e.status);
+  EXPECT_EQ(e.status->state, ExecutionState::kWaitingApproval);
+  progress(start_of(found_), 0.0, false);
+  EXPECT_EQ(status().state, ExecutionState::kWaitingApproval);
+  EXPECT_FALSE(status().departed);
+}
+
+TEST_F(RestoredSession, ASearchThatDiedWithItsProcessRunsAgain) {
+  sc_ = scenario("car_close_ahead");
+  use(sc_);
+  sc_.request.vehicle_id = "test";
+  const SessionEffects planning = session_->on_request(sc_.request, {}, now_);
+  ASSERT_EQ(planning.status->state, ExecutionState::kPlanning);
+  const SessionEffects e = restore_into_new(SessionSnapshot{sc_.request, std::nullopt, *planning.status});
+  ASSERT_TRUE(e.search);
+  EXPECT_EQ(e.search->request.request_id, sc_.request.request_id);
+  ASSERT_TRUE(e.status);
+  EXPECT_EQ(e.status->state, ExecutionState::kPlanning);
+}
+
 }  // namespace
 }  // namespace pullout

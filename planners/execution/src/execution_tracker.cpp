@@ -35,6 +35,13 @@ void ExecutionTracker::start(const PullOutPath& path) {
   stopped_since_.reset();
 }
 
+void ExecutionTracker::resume(const PullOutPath& path, std::uint32_t current_path_idx, bool completed) {
+  start(path);
+  const auto last = path.partial_paths.empty() ? 0u : static_cast<std::uint32_t>(path.partial_paths.size() - 1);
+  current_path_idx_ = std::min(current_path_idx, last);
+  completed_ = completed;
+}
+
 void ExecutionTracker::clear() {
   path_.reset();
   current_path_idx_ = 0;

@@ -336,6 +336,23 @@ std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) 
   return issues;
 }
 
+std::shared_ptr<const PlannedWorld> StartPlanner::planned_world(const PullOutRequest& request,
+                                                                std::vector<RequestIssue>& issues) const {
+  issues = validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());
+  for (auto& issue : vehicle_issues(request)) issues.push_back(std::move(issue));
+  if (!issues.empty()) return nullptr;
+  const VehicleInfo vehicle = vehicle_for(request);
+  if (request.lanes.empty() && !has_route(request)) {  // a grid-only request: no lanes (as plan())
+    return std::make_shared<const PlannedWorld>(PlannedWorld{{}, request.objects, vehicle});
+  }
+  RequestLanes lanes = request_lanes(request, map_.get(), vehicle, parameters_, limits_);
+  if (!lanes.issues.empty()) {
+    issues = std::move(lanes.issues);
+    return nullptr;
+  }
+  return std::make_shared<const PlannedWorld>(PlannedWorld{std::move(lanes.lanes), request.objects, vehicle});
+}
+
 bool StartPlanner::grid_only_allowed() const { return parameters_.freespace_planner.enable_freespace_planner; }
 
 PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const VehicleInfo& vehicle,

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "pullout/geometry/polyline.hpp"
+#include "pullout/model/names.hpp"
 #include "pullout/safety/stop_path.hpp"
 
 namespace pullout {
@@ -342,6 +343,63 @@ SessionEffects VehicleSession::on_time(Clock::time_point now) {
               "odometry lost: no progress sample for " + std::to_string(static_cast<int>(silent * 10.0) / 10.0) + " s",
               out);
   status_.state = ExecutionState::kWaitingSafety;
+  out.status = status_;
+  return out;
+}
+
+SessionEffects VehicleSession::restore(const SessionSnapshot& snapshot,
+                                       const std::shared_ptr<const PlannedWorld>& world, Clock::time_point now) {
+  const PullOutStatus& st = snapshot.status;
+  const PullOutRequest& request = snapshot.request;
+  if (st.state == ExecutionState::kPlanning && world && request.request_id == st.request_id) {
+    // The search died with the process that ran it: run it again.
+    request_stamp_ns_ = 0;  // not a repeat of anything this session has seen
+    return on_request(request, {}, now);
+  }
+  last_input_ = now;
+  forget_path();
+  ++sequence_;
+  pending_ = 0;
+  request_stamp_ns_ = request.stamp_ns;
+  goal_ = request.goal_pose;
+  request_ego_ = request.ego_pose;
+  request_ego_velocity_ = request.ego_velocity_mps;
+  planned_at_ = now;
+  objects_ = std::vector<Object>{};
+  status_ = st;
+  status_.vehicle_id = vehicle_id_;
+  SessionEffects out;
+  const bool found = snapshot.path && snapshot.path->found && !snapshot.path->partial_paths.empty() &&
+                     !snapshot.path->partial_paths.front().points.empty() && snapshot.path->request_id == st.request_id;
+  if (has_path(st.state) || st.state == ExecutionState::kPlanning) {
+    if (!found || !world || request.request_id != st.request_id) {
+      // No safety check without the world the path was planned on: nothing may drive.
+      status_ = make_status(st.request_id, ExecutionState::kNoPath);
+      status_.stop_reason = "service takeover: the request " + std::to_string(st.request_id) +
+                            " that the path answers is not known here; send the request again";
+      PullOutPath path;
+      path.request_id = st.request_id;
+      path.reasons = {status_.stop_reason};
+      out.path = stamped(std::move(path));
+      out.status = status_;
+      out.note = status_.stop_reason;
+      return out;
+    }
+    path_ = *snapshot.path;
+    published_ = *snapshot.path;
+    tracker_.resume(*path_, st.current_path_idx, st.state == ExecutionState::kCompleted);
+    status_.current_path_idx = tracker_.current_path_idx();
+    safety_.emplace(planner_.parameters(), planner_.vehicle(), world->lanes, world->objects, *path_);
+    // A stop inserted before the takeover is in the published path: resume like after one.
+    stop_inserted_ = st.departed && st.state == ExecutionState::kWaitingSafety;
+    signal_on_at_ = now;  // prepare time measured afresh here: never shorter than asked
+    out.path = stamped(published_);
+    out.note = "restored: " + std::string(to_string(st.state)) + " segment " +
+               std::to_string(status_.current_path_idx + 1) + "/" + std::to_string(path_->partial_paths.size()) +
+               (st.departed ? ", departed" : "");
+  } else if (snapshot.path) {
+    out.path = stamped(*snapshot.path);
+  }
   out.status = status_;
   return out;
 }

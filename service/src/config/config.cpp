@@ -50,6 +50,14 @@ void resolve_map(MapConfig& m, const std::filesystem::path& config_dir, Problems
   m.path = file.string();
 }
 
+// Resolves service.state_dir relative to the config file (created by the service if missing).
+void resolve_state_dir(ServiceConfig& s, const std::filesystem::path& config_dir) {
+  if (s.state_dir.empty()) return;
+  std::filesystem::path dir(s.state_dir);
+  if (dir.is_relative()) dir = config_dir / dir;
+  s.state_dir = dir.lexically_normal().string();
+}
+
 // Checks between keys of `service` (the table checks each key on its own).
 void service_problems(const ServiceConfig& s, Problems& problems) {
   const double cap = s.limits.max_deadline_ms;
@@ -288,6 +296,7 @@ Config load_config(const std::string& path, const Environment& env) {
     resolve_dds(config.dds, dir, origins.profiles_file, problems);
     resolve_security(config.dds, dir, origins.security_dir, problems);
     resolve_map(config.map, dir, problems);
+    resolve_state_dir(config.service, dir);
   }
   if (!problems.empty()) throw ConfigError(path, std::move(problems));
   return config;

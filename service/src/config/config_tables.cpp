@@ -408,6 +408,17 @@ const Table<RequestLimits>& limits_table() {
   return t;
 }
 
+const Table<ReplicaConfig>& replica_table() {
+  using T = ReplicaConfig;
+  static const Table<T> t{{
+      field("enabled", &T::enabled, "", AnyValue{},
+            "serve the fleet with the other replicas on the domain; off: another service is a duplicate"),
+      field("lease_duration_ms", &T::lease_duration_ms, "ms", in(100, 60000),
+            "DDS participant lease: a killed replica's vehicles are taken over within about this"),
+  }};
+  return t;
+}
+
 const Table<ServiceConfig>& service_table() {
   using T = ServiceConfig;
   static const Table<T> t{{
@@ -428,6 +439,12 @@ const Table<ServiceConfig>& service_table() {
               "start-up): each session holds one instance on the path and on the status writer."),
       field("session_idle_timeout_s", &T::session_idle_timeout_s, "s", in(0.0, 86400.0), "0 = never by time"),
       field("max_vehicles", &T::max_vehicles, "", in(1, 1000000), "sessions held at once"),
+      field("state_dir", &T::state_dir, "", AnyValue{},
+            "every vehicle's request, path and status kept here and read back at start-up (restart without "
+            "loss); relative to this file; empty = off"),
+      note<T>("Replicas: several services on one domain, each vehicle served by one of them; when it dies\n"
+              "another takes its vehicles over (same path, segment and approval). See README, Replicas."),
+      group("replica", &T::replica, &replica_table, ""),
       note<T>("Size limits of one request; a larger request is rejected with the field named."),
       group("limits", &T::limits, &limits_table, ""),
   }};

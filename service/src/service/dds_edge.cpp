@@ -254,8 +254,14 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
  public:
   // secure: the partitions of readers and writers matter only in secure mode. gate: released by
   // every discovery callback (FilterGate).
-  Discovery(dds::GuardCondition& wake, bool secure, int domain_id, FilterGate& gate)
-      : wake_(wake), secure_(secure), domain_id_(domain_id), gate_(gate) {}
+  Discovery(dds::GuardCondition& wake, bool secure, int domain_id, FilterGate& gate, bool replica,
+            dds::GuardCondition& replica_wake)
+      : wake_(wake),
+        secure_(secure),
+        domain_id_(domain_id),
+        gate_(gate),
+        replica_(replica),
+        replica_wake_(replica_wake) {}
 
   void on_participant_discovery(dds::DomainParticipant* /*participant*/,
                                 eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
@@ -269,6 +275,15 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
       return;
     }
     if (info.status == Status::REMOVED_PARTICIPANT || info.status == Status::DROPPED_PARTICIPANT) {
+      if (const auto r = replicas_.find(guid_prefix); r != replicas_.end()) {
+        spdlog::info("replica '{}' left DDS domain {} ({}; {} other replica(s) remain)", r->second, domain_id_,
+                     info.status == Status::DROPPED_PARTICIPANT ? "its lease expired" : "it said goodbye",
+                     replicas_.size() - 1);
+        replicas_.erase(r);
+        departed_.push_back(guid_prefix);
+        replica_wake_.set_trigger_value(true);
+        return;
+      }
       const auto it = services_.find(guid_prefix);
       if (it == services_.end()) return;
       spdlog::info("the other pullout_service '{}' left DDS domain {} ({} other service(s) remain)", it->second,
@@ -278,11 +293,18 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
     }
     const auto& data = info.info.m_userData.data_vec();
     const std::string user_data(data.begin(), data.end());
-    if (user_data != kServiceUserData || services_.count(guid_prefix) != 0) return;
+    if (user_data != kServiceUserData && user_data != kReplicaUserData) return;
+    if (services_.count(guid_prefix) != 0 || replicas_.count(guid_prefix) != 0) return;
     const std::string name = info.info.m_participantName.to_string();
-    services_.emplace(guid_prefix, name);
     std::ostringstream guid;
     guid << guid_prefix;
+    if (replica_ && user_data == kReplicaUserData) {
+      replicas_.emplace(guid_prefix, name);
+      spdlog::info("replica '{}' (GUID prefix {}) joined DDS domain {} ({} other replica(s))", name, guid.str(),
+                   domain_id_, replicas_.size());
+      return;
+    }
+    services_.emplace(guid_prefix, name);
     spdlog::warn(
         "another pullout_service is on DDS domain {}: participant '{}' (GUID prefix {}). Both plan and publish for "
         "every vehicle and the last writer wins; stop one of them or give each its own domain "
@@ -290,10 +312,22 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
         domain_id_, name, guid.str());
   }
 
-  // How many other pullout_service participants are on the domain now.
+  // How many other pullout_service participants are on the domain now (replicas of a replica
+  // not counted).
   std::size_t other_services() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return services_.size();
+  }
+  std::vector<ParticipantId> replicas() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<ParticipantId> out;
+    out.reserve(replicas_.size());
+    for (const auto& r : replicas_) out.push_back(r.first);
+    return out;
+  }
+  std::vector<ParticipantId> take_departed() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return std::exchange(departed_, {});
   }
 
   void on_subscriber_discovery(dds::DomainParticipant* /*participant*/,
@@ -367,7 +401,13 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   const bool secure_;
   const int domain_id_;
   FilterGate& gate_;
+  const bool replica_;
+  dds::GuardCondition& replica_wake_;
   mutable std::mutex mutex_;
+  // Replica mode: the other replicas now (GUID prefix -> name), and those that left since the
+  // dispatcher last asked.
+  std::map<ParticipantId, std::string> replicas_;
+  std::vector<ParticipantId> departed_;
   std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> partitions_;
   std::set<std::string> pending_readers_;
   // Other services: GUID prefix -> participant name.
@@ -377,9 +417,9 @@ class DdsEdge::Discovery final : public dds::DomainParticipantListener {
   std::deque<eprosima::fastrtps::rtps::GuidPrefix_t> foreign_order_;
 };
 
-DdsEdge::DdsEdge(const DdsConfig& config) {
+DdsEdge::DdsEdge(const DdsConfig& config, const ReplicaConfig& replica) {
   try {
-    create_entities(config);
+    create_entities(config, replica);
   } catch (...) {
     destroy();
     throw;
@@ -389,7 +429,7 @@ DdsEdge::DdsEdge(const DdsConfig& config) {
 
 DdsEdge::~DdsEdge() { destroy(); }
 
-void DdsEdge::create_entities(const DdsConfig& config) {
+void DdsEdge::create_entities(const DdsConfig& config, const ReplicaConfig& replica) {
   auto* factory = dds::DomainParticipantFactory::get_instance();
   // Fast DDS only logs a missing or malformed XML file and then silently uses its defaults (all
   // interfaces, shared memory): that must stop the service instead.
@@ -409,8 +449,20 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   }
   // Marks this participant as a pullout service for the other services' Discovery; a name that
   // says where it runs, unless the profile gives one.
-  qos.user_data().data_vec(
-      std::vector<eprosima::fastrtps::rtps::octet>(kServiceUserData.begin(), kServiceUserData.end()));
+  replica_ = replica.enabled;
+  const std::string_view mark = replica_ ? kReplicaUserData : kServiceUserData;
+  qos.user_data().data_vec(std::vector<eprosima::fastrtps::rtps::octet>(mark.begin(), mark.end()));
+  if (replica_) {
+    // The other replicas take this one's vehicles over once its lease expires: a short lease,
+    // announced four times per lease, makes that a fraction of a second after a SIGKILL.
+    auto& discovery = qos.wire_protocol().builtin.discovery_config;
+    const int ms = replica.lease_duration_ms;
+    discovery.leaseDuration =
+        eprosima::fastrtps::Duration_t(ms / 1000, static_cast<std::uint32_t>(ms % 1000) * 1'000'000);
+    const int announce = ms / 4;
+    discovery.leaseDuration_announcementperiod =
+        eprosima::fastrtps::Duration_t(announce / 1000, static_cast<std::uint32_t>(announce % 1000) * 1'000'000);
+  }
   if (qos.name().to_string().empty() || qos.name().to_string() == "RTPSParticipant") {
     char host[256] = {};
     if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
@@ -428,7 +480,8 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   filter_gate_ = std::make_unique<FilterGate>();
   matched_listener_ = std::make_unique<MatchedListener>(*filter_gate_);
   filter_factory_.set_change_hook([gate = filter_gate_.get()] { gate->hold(); });
-  discovery_ = std::make_unique<Discovery>(discovery_wake_, secure_, config.domain_id, *filter_gate_);
+  discovery_ =
+      std::make_unique<Discovery>(discovery_wake_, secure_, config.domain_id, *filter_gate_, replica_, replica_wake_);
   participant_ = factory->create_participant(config.domain_id, qos, discovery_.get(), dds::StatusMask::none());
   if (participant_ == nullptr) {
     if (secure_) {
@@ -480,6 +533,12 @@ void DdsEdge::create_entities(const DdsConfig& config) {
   };
   request_reader_ = reader(request_topic_, "request reader", kRequestReaderProfile);
   progress_reader_ = reader(progress_topic_, "progress reader", kProgressReaderProfile);
+  if (replica_) {
+    // What the replicas told their vehicles (TRANSIENT_LOCAL: a replica that starts late gets the
+    // latest of every vehicle), to take a vehicle over with exactly that.
+    replica_path_reader_ = reader(path_topic_, "replica path reader", idl::kPathReaderProfile);
+    replica_status_reader_ = reader(status_topic_, "replica status reader", idl::kStatusReaderProfile);
+  }
   // Writer-side filtering: the factory must be known before a reader is discovered.
   if (participant_->register_content_filter_factory(idl::kVehicleFilterClass, &filter_factory_) !=
       ReturnCode_t::RETCODE_OK) {
@@ -535,12 +594,26 @@ void DdsEdge::destroy() noexcept {
   }
   participant_ = nullptr;
   request_reader_ = progress_reader_ = nullptr;
+  replica_path_reader_ = replica_status_reader_ = nullptr;
   path_writer_ = status_writer_ = nullptr;
   std::lock_guard<std::mutex> lock(vehicle_writers_mutex_);
   vehicle_writers_.clear();  // deleted with the participant's entities
 }
 
 std::size_t DdsEdge::other_services() const { return discovery_ ? discovery_->other_services() : 0; }
+
+ParticipantId DdsEdge::self() const {
+  return participant_ != nullptr ? participant_->guid().guidPrefix : ParticipantId{};
+}
+
+std::vector<ParticipantId> DdsEdge::replicas() const {
+  return discovery_ ? discovery_->replicas() : std::vector<ParticipantId>{};
+}
+
+std::vector<ParticipantId> DdsEdge::take_departed_replicas() {
+  replica_wake_.set_trigger_value(false);
+  return discovery_ ? discovery_->take_departed() : std::vector<ParticipantId>{};
+}
 
 void DdsEdge::prepare_discovered_vehicles() {
   if (!secure_) return;

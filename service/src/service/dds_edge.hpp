@@ -36,6 +36,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include <fastdds/rtps/common/Guid.h>
 #include <fastdds/dds/core/condition/GuardCondition.hpp>
 
 #include "pullout/config/config.hpp"
@@ -55,8 +56,13 @@ struct SampleInfo;
 
 namespace pullout::service {
 
-// The participant user data that marks a pullout service (other services look for it).
+// The participant user data that marks a pullout service (other services look for it), and a
+// service in replica mode (service.replica.enabled).
 inline constexpr std::string_view kServiceUserData = "pullout_service";
+inline constexpr std::string_view kReplicaUserData = "pullout_service replica";
+
+// A participant's GUID prefix: who a replica is on the domain.
+using ParticipantId = eprosima::fastrtps::rtps::GuidPrefix_t;
 
 class DdsSetupError : public std::runtime_error {
  public:
@@ -76,7 +82,9 @@ class DdsEdge final : public Outbox {
  public:
   // `config.profiles_file` must name a readable Fast DDS XML file (load_config resolves it), or be
   // empty: the built-in profiles (builtin_profiles.hpp).
-  explicit DdsEdge(const DdsConfig& config);
+  // `replica`: service.replica; enabled, the participant is marked as a replica, announces the
+  // replica lease, and the edge reads the path and status topics too (replica_*_reader).
+  explicit DdsEdge(const DdsConfig& config, const ReplicaConfig& replica = {});
   ~DdsEdge() override;
   DdsEdge(const DdsEdge&) = delete;
   DdsEdge& operator=(const DdsEdge&) = delete;
@@ -90,9 +98,18 @@ class DdsEdge final : public Outbox {
   // no writer). Thread-safe.
   bool forget_vehicle(const std::string& vehicle_id) override;
 
-  // How many other pullout_service participants (user data kServiceUserData) are on the domain
-  // now; each one that appears is logged as a warning. Thread-safe.
+  // How many other pullout_service participants are on the domain now that are duplicates (both
+  // serving every vehicle): every other service when this one is not a replica, the services
+  // that are not replicas when it is. Each one that appears is logged as a warning. Thread-safe.
   std::size_t other_services() const;
+  // Replica mode: this participant, and the other replicas on the domain now. Thread-safe.
+  ParticipantId self() const;
+  std::vector<ParticipantId> replicas() const;
+  // Replica mode: the replicas that left since the last call (dispatcher thread); their leaving
+  // triggers replica_condition().
+  std::vector<ParticipantId> take_departed_replicas();
+  eprosima::fastdds::dds::GuardCondition& replica_condition() { return replica_wake_; }
+  bool replica() const { return replica_; }
 
   // The smallest resource_limits.max_instances of the four endpoints (0: unlimited): the most
   // vehicles the service can hold sessions for.
@@ -118,6 +135,9 @@ class DdsEdge final : public Outbox {
   // For the dispatcher thread only (take samples, wait on their status conditions).
   eprosima::fastdds::dds::DataReader& request_reader() { return *request_reader_; }
   eprosima::fastdds::dds::DataReader& progress_reader() { return *progress_reader_; }
+  // Replica mode only (null otherwise): every vehicle's path and status, as the replicas publish them.
+  eprosima::fastdds::dds::DataReader* replica_path_reader() { return replica_path_reader_; }
+  eprosima::fastdds::dds::DataReader* replica_status_reader() { return replica_status_reader_; }
 
  private:
   class Discovery;        // the participant listener: discovered writers' partitions, other vendors' participants
@@ -130,7 +150,7 @@ class DdsEdge final : public Outbox {
     eprosima::fastdds::dds::DataWriter* status{nullptr};
   };
 
-  void create_entities(const DdsConfig& config);
+  void create_entities(const DdsConfig& config, const ReplicaConfig& replica);
   void check_qos() const;
   void destroy() noexcept;
   // The writer for this vehicle's paths (`path` true) or statuses; null when it cannot be created.
@@ -152,6 +172,8 @@ class DdsEdge final : public Outbox {
   eprosima::fastdds::dds::Topic* progress_topic_{nullptr};
   eprosima::fastdds::dds::DataReader* request_reader_{nullptr};
   eprosima::fastdds::dds::DataReader* progress_reader_{nullptr};
+  eprosima::fastdds::dds::DataReader* replica_path_reader_{nullptr};
+  eprosima::fastdds::dds::DataReader* replica_status_reader_{nullptr};
   eprosima::fastdds::dds::DataWriter* path_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* status_writer_{nullptr};
   // The generated type support keeps per-type scratch buffers (key serialisation), so writes of
@@ -160,7 +182,9 @@ class DdsEdge final : public Outbox {
   std::mutex status_mutex_;
 
   bool secure_{false};
+  bool replica_{false};
   eprosima::fastdds::dds::GuardCondition discovery_wake_;
+  eprosima::fastdds::dds::GuardCondition replica_wake_;
   std::unique_ptr<Discovery> discovery_;
   std::mutex vehicle_writers_mutex_;  // guards vehicle_writers_
   std::unordered_map<std::string, VehicleWriters> vehicle_writers_;

@@ -60,14 +60,22 @@ std::unique_ptr<ServiceMetrics> make_metrics(const Config& config) {
   return std::make_unique<ServiceMetrics>(kVersionString);
 }
 
+std::unique_ptr<StateJournal> make_journal(const Config& config, Outbox& next) {
+  if (config.service.state_dir.empty()) return nullptr;
+  return std::make_unique<StateJournal>(config.service.state_dir, next);
+}
+
 }  // namespace
 
 PulloutService::PulloutService(const Config& config, std::shared_ptr<const LaneletMap> map)
     : config_(config),
       metrics_(make_metrics(config)),
-      dds_(config.dds),
-      planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map), config.vehicle_profiles),
-      registry_(planner_, dds_, registry_options(config.service, metrics_.get())) {
+      dds_(config.dds, config.service.replica),
+      journal_(make_journal(config, dds_)),
+      planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map),
+               config.vehicle_profiles),
+      registry_(planner_, journal_ ? static_cast<Outbox&>(*journal_) : dds_,
+                registry_options(config.service, metrics_.get())) {
   health_.config_loaded = true;  // load_config validated it
   health_.dds_ready = true;      // DdsEdge throws unless the participant and every endpoint exist
   // Every session holds one instance on the path and on the status writer, and a vehicle that is
@@ -80,6 +88,7 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
                         " of the DDS profiles in " + describe_profiles(config.dds) +
                         ": lower max_vehicles or raise max_instances");
   }
+  if (config.service.replica.enabled) shadows_ = std::make_unique<ReplicaShadows>(config.service.max_vehicles);
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
   health_.workers_running = true;
   if (metrics_) {
@@ -93,6 +102,7 @@ PulloutService::~PulloutService() { stop(); }
 
 void PulloutService::start() {
   if (dispatcher_.joinable() || stopping_) return;
+  if (journal_) restore_from_journal();
   dispatcher_ = std::thread([this] { dispatch_loop(); });
 }
 
@@ -110,6 +120,35 @@ void PulloutService::stop() {
   });
 }
 
+void PulloutService::restore_from_journal() {
+  const auto t0 = std::chrono::steady_clock::now();
+  JournalLoad loaded = journal_->load(config_.service.session_idle_timeout_s);
+  for (const std::string& problem : loaded.problems) spdlog::warn("state journal: {} (ignored)", problem);
+  for (JournalEntry& e : loaded.entries) {
+    SessionSnapshot snapshot;
+    if (e.request) snapshot.request = std::move(*e.request);
+    snapshot.path = std::move(e.path);
+    snapshot.status = std::move(e.status);
+    restore(snapshot, e.request ? e.request_issues : std::vector<RequestIssue>{{"request", "not in the journal"}});
+  }
+  spdlog::info("state journal {}: {} vehicle(s) restored, {} file(s) ignored in {:.1f} ms", config_.service.state_dir,
+               loaded.entries.size(), loaded.problems.size(),
+               std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+}
+
+void PulloutService::restore(const SessionSnapshot& snapshot, const std::vector<RequestIssue>& request_issues) {
+  std::shared_ptr<const PlannedWorld> world;
+  std::vector<RequestIssue> issues = request_issues;
+  if (issues.empty()) world = planner_.planned_world(snapshot.request, issues);
+  if (!world && has_path(snapshot.status.state)) {
+    spdlog::warn("vehicle '{}' request {}: no world for the safety check ({}: {}): the vehicle must send it again",
+                 snapshot.status.vehicle_id, snapshot.status.request_id, issues.empty() ? "?" : issues.front().field,
+                 issues.empty() ? "?" : issues.front().problem);
+  }
+  std::optional<PlanningJob> job = registry_.restore(snapshot, std::move(world));
+  if (job) queue_->push(std::move(*job));
+}
+
 double PulloutService::effective_deadline_ms(double requested_ms) const {
   const double budget = requested_ms > 0.0 ? requested_ms : config_.service.default_deadline_ms;
   return std::min(budget, config_.service.limits.max_deadline_ms);
@@ -125,6 +164,17 @@ void PulloutService::dispatch_loop() {
   waitset.attach_condition(progress);
   waitset.attach_condition(shutdown_);
   if (dds_.secure()) waitset.attach_condition(dds_.discovery_condition());
+  dds::StatusCondition* replica_paths = nullptr;
+  dds::StatusCondition* replica_statuses = nullptr;
+  if (shadows_) {
+    replica_paths = &dds_.replica_path_reader()->get_statuscondition();
+    replica_statuses = &dds_.replica_status_reader()->get_statuscondition();
+    replica_paths->set_enabled_statuses(dds::StatusMask::data_available());
+    replica_statuses->set_enabled_statuses(dds::StatusMask::data_available());
+    waitset.attach_condition(*replica_paths);
+    waitset.attach_condition(*replica_statuses);
+    waitset.attach_condition(dds_.replica_condition());
+  }
   spdlog::debug("dispatcher running");
   health_.beat();
 
@@ -140,6 +190,10 @@ void PulloutService::dispatch_loop() {
     health_.beat();
     dds_.prepare_discovered_vehicles();
     // Both readers are drained on every wake-up: cheap when empty, and it cannot miss data.
+    if (shadows_) {
+      take_replica_samples();
+      take_over_departed();
+    }
     take_requests();
     take_progress();
     const auto now = std::chrono::steady_clock::now();
@@ -165,6 +219,11 @@ void PulloutService::dispatch_loop() {
   waitset.detach_condition(progress);
   waitset.detach_condition(shutdown_);
   if (dds_.secure()) waitset.detach_condition(dds_.discovery_condition());
+  if (shadows_) {
+    waitset.detach_condition(*replica_paths);
+    waitset.detach_condition(*replica_statuses);
+    waitset.detach_condition(dds_.replica_condition());
+  }
   spdlog::debug("dispatcher stopped");
 }
 
@@ -178,6 +237,13 @@ void PulloutService::take_requests() {
       if (info.valid_data) {
         if (!sender_allowed(info, sample.vehicle_id(), "request")) continue;
         request_instances_[info.instance_handle] = sample.vehicle_id();
+        if (shadows_ && !serving(sample.vehicle_id())) {
+          // Another replica serves it: kept for a takeover (decoded and validated then).
+          std::vector<RequestIssue> issues;
+          PullOutRequest request = idl::from_msg(sample, issues);
+          if (issues.empty() && sample.vehicle_id().size() <= kMaxVehicleIdBytes) shadows_->keep_request(request);
+          continue;
+        }
         handle_request(sample);
       } else {
         instance_gone(request_instances_, info, VehicleInput::kRequest);
@@ -199,6 +265,7 @@ void PulloutService::take_progress() {
       if (info.valid_data) {
         if (!sender_allowed(info, sample.vehicle_id(), "progress")) continue;
         progress_instances_[info.instance_handle] = sample.vehicle_id();
+        if (shadows_ && !registry_.holds(sample.vehicle_id())) continue;  // another replica's vehicle
         handle_progress(sample);
       } else {
         instance_gone(progress_instances_, info, VehicleInput::kProgress);
@@ -206,6 +273,77 @@ void PulloutService::take_progress() {
     } catch (const std::exception& e) {
       spdlog::error("progress sample dropped: {}", e.what());
     }
+  }
+}
+
+bool PulloutService::serving(const std::string& vehicle_id) const {
+  return registry_.holds(vehicle_id) || shadows_->serves(vehicle_id, dds_.self(), dds_.replicas());
+}
+
+void PulloutService::take_replica_samples() {
+  const ParticipantId self = dds_.self();
+  const auto writer_of = [](const dds::SampleInfo& info) {
+    return eprosima::fastrtps::rtps::iHandle2GUID(info.publication_handle).guidPrefix;
+  };
+  // A vehicle another replica speaks for: shadowed; if this replica serves it too (two replicas
+  // decided on different views of who is alive), the one with the smaller GUID prefix yields.
+  const auto note_owner = [&](const std::string& vehicle_id, const ParticipantId& writer) -> ReplicaShadows::Shadow* {
+    if (writer == self) {
+      shadows_->erase(vehicle_id);  // this replica serves it
+      return nullptr;
+    }
+    if (registry_.holds(vehicle_id)) {
+      if (writer < self) return nullptr;  // the other one yields
+      registry_.release(vehicle_id);
+      spdlog::warn("vehicle '{}': another replica serves it too; this one yields", vehicle_id);
+    }
+    ReplicaShadows::Shadow* shadow = shadows_->at(vehicle_id);
+    if (shadow != nullptr) shadow->owner = writer;
+    return shadow;
+  };
+  {
+    msg::PullOutPath sample;
+    dds::SampleInfo info;
+    while (!stopping_ && dds_.replica_path_reader()->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      if (ReplicaShadows::Shadow* s = note_owner(sample.vehicle_id(), writer_of(info))) s->path = idl::from_msg(sample);
+    }
+  }
+  msg::PullOutStatus sample;
+  dds::SampleInfo info;
+  while (!stopping_ && dds_.replica_status_reader()->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data) {
+      // Disposed: the owner evicted the vehicle (not the owner dying: that is no writers).
+      const auto it = replica_status_instances_.find(info.instance_handle);
+      if (it == replica_status_instances_.end()) continue;
+      if (info.instance_state == dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE) shadows_->erase(it->second);
+      if (info.instance_state != dds::NOT_ALIVE_NO_WRITERS_INSTANCE_STATE) replica_status_instances_.erase(it);
+      continue;
+    }
+    replica_status_instances_[info.instance_handle] = sample.vehicle_id();
+    if (ReplicaShadows::Shadow* s = note_owner(sample.vehicle_id(), writer_of(info))) s->status = idl::from_msg(sample);
+  }
+}
+
+void PulloutService::take_over_departed() {
+  for (const ParticipantId& departed : dds_.take_departed_replicas()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const ParticipantId self = dds_.self();
+    const std::vector<ParticipantId> others = dds_.replicas();
+    std::size_t taken = 0;
+    const std::vector<std::string> vehicles = shadows_->owned_by(departed);
+    for (const std::string& vehicle_id : vehicles) {
+      if (!shadows_->serves(vehicle_id, self, others)) continue;  // another replica wins it
+      bool request_known = false;
+      const std::optional<SessionSnapshot> snapshot = shadows_->snapshot(vehicle_id, request_known);
+      shadows_->erase(vehicle_id);
+      if (!snapshot) continue;
+      restore(*snapshot, request_known ? std::vector<RequestIssue>{}
+                                       : std::vector<RequestIssue>{{"request", "not seen by this replica"}});
+      ++taken;
+    }
+    spdlog::info("took over {} of the {} vehicle(s) of the replica that left, in {:.1f} ms", taken, vehicles.size(),
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
 }
 
@@ -250,6 +388,7 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
                  sample.vehicle_id().size(), kMaxVehicleIdBytes);
     return;
   }
+  if (journal_) journal_->on_request(sample);
   std::vector<RequestIssue> issues;
   PullOutRequest request = idl::from_msg(sample, issues);
   if (!issues.empty()) {

@@ -30,6 +30,8 @@
 #include "pullout/pipeline/start_planner.hpp"
 #include "service/dds_edge.hpp"
 #include "service/planning_queue.hpp"
+#include "service/replicas.hpp"
+#include "service/state_journal.hpp"
 #include "service/vehicle_registry.hpp"
 
 namespace eprosima::fastdds::dds {
@@ -72,6 +74,11 @@ class PulloutService {
   void dispatch_loop();
   void take_requests();
   void take_progress();
+  // Replica mode: the other replicas' paths and statuses (shadows), and the vehicles of replicas
+  // that left (taken over when this replica wins them).
+  void take_replica_samples();
+  void take_over_departed();
+  bool serving(const std::string& vehicle_id) const;
   // Whether the sample's writer may speak for vehicle_id (DdsEdge::sender_may_act_for); logs a
   // refusal, rate-limited.
   bool sender_allowed(const eprosima::fastdds::dds::SampleInfo& info, const std::string& vehicle_id, const char* what);
@@ -83,12 +90,18 @@ class PulloutService {
   void handle_request(const msg::PullOutRequest& sample);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
+  // service.state_dir: every vehicle of the journal restored (before the dispatcher starts).
+  void restore_from_journal();
+  // A snapshot's session rebuilt in the registry, its search (if any) queued.
+  void restore(const SessionSnapshot& snapshot, const std::vector<RequestIssue>& request_issues);
 
   Config config_;
   // First: the registry's and the queue's observers use them until those are gone.
   HealthState health_;
   std::unique_ptr<ServiceMetrics> metrics_;  // null when observability.metrics is off
   DdsEdge dds_;
+  // service.state_dir: journals what the registry publishes, then hands it to dds_ (null: off).
+  std::unique_ptr<StateJournal> journal_;
   StartPlanner planner_;
   VehicleRegistry registry_;
   std::atomic<bool> stopping_{false};
@@ -104,6 +117,9 @@ class PulloutService {
   // Dispatcher thread only.
   InstanceNames request_instances_;
   InstanceNames progress_instances_;
+  // Replica mode (null otherwise): the vehicles other replicas serve. Dispatcher thread only.
+  std::unique_ptr<ReplicaShadows> shadows_;
+  InstanceNames replica_status_instances_;
   // Last: destroyed (workers joined) before the registry and the DDS entities they use.
   std::unique_ptr<PlanningQueue> queue_;
   // After the queue: serves /readyz about everything above; stopped first.

@@ -368,6 +368,44 @@ void VehicleRegistry::on_time() {
   for (const auto& [i, why] : evict) forget(*slots[i].second, slots[i].first, why, now);
 }
 
+std::optional<PlanningJob> VehicleRegistry::restore(const SessionSnapshot& snapshot,
+                                                    std::shared_ptr<const PlannedWorld> world) {
+  const std::string& vehicle_id = snapshot.status.vehicle_id;
+  release(vehicle_id);  // a fresh session: nothing of an earlier one carries over
+  const auto now = options_.clock();
+  const auto slot = find_or_admit(vehicle_id, now);
+  if (!slot) {
+    spdlog::error("vehicle '{}' not restored: service.max_vehicles sessions are held and none is idle", vehicle_id);
+    return std::nullopt;
+  }
+  std::unique_lock<std::mutex> lock(slot->mutex);
+  if (slot->evicted) return std::nullopt;
+  // Alive until its readers say otherwise: a vehicle that never comes back goes by the idle timeout.
+  slot->request_alive = true;
+  slot->progress_alive = true;
+  SessionEffects effects = slot->session.restore(snapshot, world, now);
+  spdlog::info("vehicle '{}' request {}: {}", vehicle_id, snapshot.status.request_id,
+               effects.note.empty() ? std::string("restored in state ") + pullout::to_string(snapshot.status.state)
+                                    : effects.note);
+  effects.note.clear();
+  return settle(*slot, lock, std::move(effects), vehicle_id);
+}
+
+bool VehicleRegistry::release(const std::string& vehicle_id) {
+  std::shared_ptr<Slot> slot;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = vehicles_.find(vehicle_id);
+    if (it == vehicles_.end()) return false;
+    slot = it->second;
+    vehicles_.erase(it);
+  }
+  std::lock_guard<std::mutex> lock(slot->mutex);
+  slot->evicted = true;
+  if (slot->cancel) slot->cancel->store(true);
+  return true;
+}
+
 void VehicleRegistry::on_instance_gone(const std::string& vehicle_id, VehicleInput input) {
   const auto slot = find(vehicle_id);
   if (!slot) return;

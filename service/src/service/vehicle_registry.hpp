@@ -107,6 +107,15 @@ class VehicleRegistry {
   // The vehicle's instance on that reader is no longer alive (unregistered, disposed, or no writer
   // left). A later valid sample makes it alive again. Unknown vehicles are ignored.
   void on_instance_gone(const std::string& vehicle_id, VehicleInput input);
+  // Rebuilds the vehicle's session from a snapshot (VehicleSession::restore; `world`:
+  // StartPlanner::planned_world of snapshot.request, null when unknown) and publishes its path and
+  // status: a replica taking the vehicle over, or the service restarting. Replaces a session held
+  // for it. Returns the search to queue (a search that died with its process). Null when the
+  // registry is full of busy sessions (logged).
+  std::optional<PlanningJob> restore(const SessionSnapshot& snapshot, std::shared_ptr<const PlannedWorld> world);
+  // Drops the vehicle's session without a word on DDS (another replica serves it now): its
+  // search is cancelled, nothing more is published for it. Returns whether one was held.
+  bool release(const std::string& vehicle_id);
   // Time passes: every session's on_time (the odometry watchdog), then the eviction sweep.
   void on_time();
 

@@ -53,6 +53,14 @@ inline constexpr std::array<const char*, 5> kSecurityFileNames{"ca.pem", "cert.p
 // spdlog's level names: the values of service.log_level and pullout_service --log-level.
 inline constexpr std::array<const char*, 7> kLogLevels{"trace", "debug", "info", "warn", "error", "critical", "off"};
 
+// Several pullout_service replicas on one domain serving one fleet (README, Replicas).
+struct ReplicaConfig {
+  bool enabled{false};  // off: a second service on the domain is a duplicate (warned about)
+  // [ms] This participant's DDS lease (announced every quarter of it): how soon the other
+  // replicas notice that it died and take its vehicles over.
+  int lease_duration_ms{500};
+};
+
 struct ServiceConfig {
   int worker_threads{2};
   double default_deadline_ms{200.0};  // [ms]
@@ -66,6 +74,11 @@ struct ServiceConfig {
   // Sessions held at once; when full, the least recently active idle one makes room, and when
   // none is idle a new vehicle is rejected. At most the DDS profiles' max_instances.
   std::size_t max_vehicles{2048};
+  // A directory where every vehicle's latest request, path and status are kept (one file each,
+  // replaced atomically), read back at start-up: a killed service restarts without losing its
+  // vehicles. Relative to the config file; empty: off.
+  std::string state_dir;
+  ReplicaConfig replica;
 };
 
 struct MapConfig {

@@ -26,6 +26,9 @@ class ExecutionTracker {
 
   // Starts following `path` (a found path) from segment 0.
   void start(const PullOutPath& path);
+  // Follows `path` from segment `current_path_idx` (clamped to the last), completed or not: a
+  // session restored from a snapshot. The standstill is measured afresh.
+  void resume(const PullOutPath& path, std::uint32_t current_path_idx, bool completed);
   // Forgets the path (no path, rejected request).
   void clear();
   // Keeps following the same path, with its segment index and stop timer, under another request

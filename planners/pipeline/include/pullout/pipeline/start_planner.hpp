@@ -118,6 +118,12 @@ class StartPlanner {
   // default vehicle.
   VehicleInfo vehicle_for(const PullOutRequest& request) const;
 
+  // The world plan() plans `request` on (its lanes, inline or picked on the map, and its objects),
+  // without planning: what a session restored from a snapshot (VehicleSession::restore) checks
+  // safety on. Null with `issues` filled when the request is not valid.
+  std::shared_ptr<const PlannedWorld> planned_world(const PullOutRequest& request,
+                                                    std::vector<RequestIssue>& issues) const;
+
   // The default vehicle.
   const VehicleInfo& vehicle() const { return vehicle_; }
   const VehicleProfiles& profiles() const { return profiles_; }

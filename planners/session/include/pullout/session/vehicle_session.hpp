@@ -102,6 +102,16 @@ struct SessionEffects {
   bool empty() const { return !path && !status && !search && !cancel_search; }
 };
 
+// What a vehicle was last told, and the request it answers: enough to rebuild its session in
+// another process (a replica taking the vehicle over, the service after a restart).
+struct SessionSnapshot {
+  // The request status.request_id answers (for a path: planned for it, or the re-sent request
+  // whose objects updated it). Its lanes and objects are what the safety check uses.
+  PullOutRequest request;
+  std::optional<PullOutPath> path;  // the path last published for it (found or not)
+  PullOutStatus status;             // the status last published
+};
+
 class VehicleSession {
  public:
   using Clock = std::chrono::steady_clock;
@@ -126,6 +136,20 @@ class VehicleSession {
                              const std::vector<FleetObstacle>& fleet = {});
   // Time passes with no input (called periodically).
   SessionEffects on_time(Clock::time_point now);
+  // Rebuilds a fresh session (nothing received yet) from `snapshot`; `world` is what
+  // StartPlanner::planned_world gives for snapshot.request (null: the request is unknown or not
+  // valid). The vehicle keeps its path, current_path_idx, departure and approval state:
+  //   - kPlanning: the request is searched again (a SearchOrder);
+  //   - a found path and a world: the path is followed again from current_path_idx, the safety
+  //     checked on `world`; not departed: the turn signal's prepare time is measured afresh on
+  //     this session's clock (never shorter); departed and kWaitingSafety: resumes only stopped,
+  //     safe and approved, like after an inserted stop;
+  //   - a found path and no world: without a safety check nothing may drive: kNoPath, a path with
+  //     found = false and the reason (the vehicle sends its request again);
+  //   - any other state: kept as it is.
+  // The effects re-publish the path and the status (the same request id and segments).
+  SessionEffects restore(const SessionSnapshot& snapshot, const std::shared_ptr<const PlannedWorld>& world,
+                         Clock::time_point now);
   // The found path of `request_id` could not be published (a transport failure): the vehicle
   // never got it, so it is not followed (kNoPath with the reason).
   SessionEffects on_path_undeliverable(std::uint64_t request_id);
