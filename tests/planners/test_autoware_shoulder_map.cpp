@@ -34,7 +34,7 @@ using namespace oracle;  // NOLINT: the test's own helpers
 
 // Shoulders passing at every possible start yaw, as measured when this test was written.
 constexpr std::size_t kShiftShoulderFloor = 40;
-constexpr std::size_t kGeometricShoulderFloor = 24;
+constexpr std::size_t kGeometricShoulderFloor = 37;
 
 const std::string kMap = std::string(PULLOUT_SOURCE_DIR) + "/../shared/maps/autoware_road_shoulder/lanelet2_map.osm";
 
@@ -44,12 +44,19 @@ struct Verdict {
 };
 
 // The path is inside the map's road and shoulder lanelets (expanded footprint as the planner's
-// own lane check) and turns no tighter than the vehicle can, up to the end pose.
+// own lane check; for geometric, the oracle's geometric_lane_footprint from the first forward
+// segment's start) and turns no tighter than the vehicle can, up to the end pose.
 std::string oracle_problem(const PullOutPath& path, const std::vector<Polygon>& lanes, const VehicleInfo& vehicle,
                            const StartPlannerParameters& params) {
-  const double expansion = path.planner_type == PlannerType::kGeometric ? params.lane_departure_margin
-                                                                        : params.lane_departure_check_expansion_margin;
-  const Footprint fp = vehicle_footprint(vehicle, expansion);
+  Footprint fp = vehicle_footprint(vehicle, params.lane_departure_check_expansion_margin);
+  if (path.planner_type == PlannerType::kGeometric) {
+    for (const auto& seg : path.partial_paths) {
+      if (direction_of(seg) > 0.0 && !seg.points.empty()) {
+        fp = geometric_lane_footprint(vehicle, params, seg.points.front().pose, path.end_pose, lanes);
+        break;
+      }
+    }
+  }
   const double k_max = 1.0 / vehicle.min_turning_radius_m();
   for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
     const auto& points = path.partial_paths[k].points;
