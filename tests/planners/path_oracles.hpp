@@ -116,7 +116,10 @@ inline Polygon lane_polygon(const Lane& lane) {
 
 // Every point of the footprint outline (every 5 cm), pulled 1 mm inwards so that a footprint
 // flush with a lane edge counts as inside, lies in some lane.
-inline bool footprint_in_lanes(const Footprint& f, const Pose2& pose, const std::vector<Polygon>& lanes) {
+// With closed_gap > 0, a point outside every lane still counts as inside when the distances to
+// the two nearest lanes add up to at most closed_gap (it lies in a sliver between them).
+inline bool footprint_in_lanes(const Footprint& f, const Pose2& pose, const std::vector<Polygon>& lanes,
+                               double closed_gap = 0.0) {
   Footprint shrunk{f.front - 1e-3, f.rear - 1e-3, f.left - 1e-3, f.right - 1e-3};
   const auto c = footprint_corners(shrunk, pose);
   for (std::size_t k = 0; k < 4; ++k) {
@@ -127,6 +130,21 @@ inline bool footprint_in_lanes(const Footprint& f, const Pose2& pose, const std:
       const Vec2 p = a + (b - a) * (static_cast<double>(i) / n);
       bool inside = false;
       for (const Polygon& l : lanes) inside = inside || point_in_polygon(l, p);
+      if (!inside && closed_gap > 0.0) {
+        double d1 = std::numeric_limits<double>::infinity();
+        double d2 = d1;
+        for (const Polygon& l : lanes) {
+          double d = std::numeric_limits<double>::infinity();
+          for (std::size_t e = 0; e < l.size(); ++e) d = std::min(d, point_segment(p, l[e], l[(e + 1) % l.size()]));
+          if (d < d1) {
+            d2 = d1;
+            d1 = d;
+          } else if (d < d2) {
+            d2 = d;
+          }
+        }
+        inside = d1 + d2 <= closed_gap;
+      }
       if (!inside) return false;
     }
   }

@@ -36,6 +36,12 @@ using namespace oracle;  // NOLINT: the test's own helpers
 constexpr std::size_t kShiftShoulderFloor = 40;
 constexpr std::size_t kGeometricShoulderFloor = 37;
 
+// [m] Neighbouring lanelets of these maps are sometimes a few centimetres apart instead of
+// sharing a bound (675 and 676 on the road_shoulder map: 4.8 cm); the lane world joins lanes whose
+// edges are within 5 cm (its shared-edge probe), and so does the oracle: a point in a gap between
+// two lanelets at most this wide counts as inside.
+constexpr double kClosedGap = 0.05;
+
 const std::string kMap = std::string(PULLOUT_SOURCE_DIR) + "/../shared/maps/autoware_road_shoulder/lanelet2_map.osm";
 
 struct Verdict {
@@ -63,7 +69,7 @@ std::string oracle_problem(const PullOutPath& path, const std::vector<Polygon>& 
     if (points.size() < 2) return "segment " + std::to_string(k) + " has fewer than 2 points";
     for (std::size_t i = 0; i < points.size(); ++i) {
       const Pose2& pose = points[i].pose;
-      if (!footprint_in_lanes(fp, pose, lanes)) {
+      if (!footprint_in_lanes(fp, pose, lanes, kClosedGap)) {
         return "oracle: lane departure at segment " + std::to_string(k) + " point " + std::to_string(i);
       }
       if (i > 0 && i + 1 < points.size()) {
@@ -206,6 +212,11 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
   // vehicle stood beside a corner of the road's centerline polyline).
   for (PlannerType type : {PlannerType::kShift, PlannerType::kGeometric}) {
     for (const auto& f : failures[type]) EXPECT_EQ(f.find("does not start at the vehicle"), std::string::npos) << f;
+    // Every path the planner's own lane check accepts is inside the lanelets by the oracle too
+    // (4 shift paths on shoulders 534 and 678 crossed a 4.8 cm gap between lanelets 675 and 676
+    // that the lane world joins; the oracle now closes such gaps too, kClosedGap). The oracle's
+    // curvature findings (shoulders 534, 678, 10988-10997) are reported, not asserted.
+    for (const auto& f : failures[type]) EXPECT_EQ(f.find("oracle: lane departure"), std::string::npos) << f;
   }
 }
 
