@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <limits>
 
 #include "../planners/path_oracles.hpp"
 #include "pullout/collision/footprint.hpp"
@@ -22,8 +23,8 @@
 namespace pullout {
 namespace {
 
-const char* const kFreespaceScenarios[] = {"freespace_boxed_in", "freespace_perpendicular_bay",
-                                           "freespace_parking_lot"};
+const char* const kFreespaceScenarios[] = {"freespace_boxed_in", "freespace_perpendicular_bay", "freespace_parking_lot",
+                                           "freespace_kerb"};
 
 Scenario load(const std::string& name) {
   return load_scenario(std::string(PULLOUT_SOURCE_DIR) + "/tests/scenarios/" + name + ".yaml");
@@ -63,8 +64,31 @@ TEST_P(FreespaceScenario, FindsADrivablePath) {
   const OccupancyGrid* grid = sc.request.occupancy_grid ? &*sc.request.occupancy_grid : nullptr;
   const int threshold = fp.costmap_configs.obstacle_threshold;
   const Footprint body = vehicle_footprint(sc.vehicle);
-  // 1 mm less than the promise: the oracle's rounding, far below the 0.1 to 0.2 m margins.
-  const Footprint grown = vehicle_footprint(sc.vehicle, 0.5 * fp.vehicle_shape_margin - 1e-3);
+  // The margin yields where the start has less room (freespace_pull_out.hpp): at least, every
+  // side keeps half the margin or the start's smallest clearance (to the objects and the lane
+  // edges, measured here) less the swing of a rear corner grown by half the margin on a full-lock
+  // turn, less the search's sweep tolerance (a quarter of a cell) and 1 cm.
+  const Footprint body0 = vehicle_footprint(sc.vehicle);
+  double start_room = std::numeric_limits<double>::infinity();
+  for (const Object& o : sc.request.objects) {
+    start_room = std::min(
+        start_room, oracle::polygon_distance(oracle::rectangle_at(body0, sc.request.ego_pose), object_polygon(o)));
+  }
+  if (!sc.request.lanes.empty()) {
+    std::vector<Polygon> lane_polygons;
+    for (const Lane& l : sc.request.lanes) lane_polygons.push_back(oracle::lane_polygon(l));
+    for (double Footprint::*side : {&Footprint::front, &Footprint::rear, &Footprint::left, &Footprint::right}) {
+      start_room = std::min(start_room, oracle::side_gap(body0, side, sc.request.ego_pose, lane_polygons, 2.0));
+    }
+  }
+  const double half = 0.5 * fp.vehicle_shape_margin;
+  const double turn = sc.vehicle.wheel_base_m / std::tan(sc.vehicle.max_steer_angle_rad * fp.max_turning_ratio);
+  const double u = turn + std::min(body0.left, body0.right);
+  const double swing = std::hypot(u, body0.rear + half) - u;
+  const double promised =
+      std::min(half, std::max(0.0, start_room - swing - 0.25 * fp.costmap_configs.resolution - 0.01));
+  // 1 mm less than the promise: the oracle's rounding.
+  const Footprint grown = vehicle_footprint(sc.vehicle, std::max(0.0, promised - 1e-3));
   const auto touches = [&](const Footprint& f, const Pose2& pose) {
     const Polygon rect = oracle::rectangle_at(f, pose);
     for (const Polygon& o : objects) {

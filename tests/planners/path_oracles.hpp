@@ -13,7 +13,9 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/geometry/angle.hpp"
 #include "pullout/geometry/polygon.hpp"
+#include "pullout/lane_planners/lane_planner_parameters.hpp"
 #include "pullout/model/types.hpp"
+#include "pullout/vehicle/vehicle_info.hpp"
 
 namespace pullout::oracle {
 
@@ -114,7 +116,10 @@ inline Polygon lane_polygon(const Lane& lane) {
 
 // Every point of the footprint outline (every 5 cm), pulled 1 mm inwards so that a footprint
 // flush with a lane edge counts as inside, lies in some lane.
-inline bool footprint_in_lanes(const Footprint& f, const Pose2& pose, const std::vector<Polygon>& lanes) {
+// With closed_gap > 0, a point outside every lane still counts as inside when the distances to
+// the two nearest lanes add up to at most closed_gap (it lies in a sliver between them).
+inline bool footprint_in_lanes(const Footprint& f, const Pose2& pose, const std::vector<Polygon>& lanes,
+                               double closed_gap = 0.0) {
   Footprint shrunk{f.front - 1e-3, f.rear - 1e-3, f.left - 1e-3, f.right - 1e-3};
   const auto c = footprint_corners(shrunk, pose);
   for (std::size_t k = 0; k < 4; ++k) {
@@ -125,10 +130,46 @@ inline bool footprint_in_lanes(const Footprint& f, const Pose2& pose, const std:
       const Vec2 p = a + (b - a) * (static_cast<double>(i) / n);
       bool inside = false;
       for (const Polygon& l : lanes) inside = inside || point_in_polygon(l, p);
+      if (!inside && closed_gap > 0.0) {
+        double d1 = std::numeric_limits<double>::infinity();
+        double d2 = d1;
+        for (const Polygon& l : lanes) {
+          double d = std::numeric_limits<double>::infinity();
+          for (std::size_t e = 0; e < l.size(); ++e) d = std::min(d, point_segment(p, l[e], l[(e + 1) % l.size()]));
+          if (d < d1) {
+            d2 = d1;
+            d1 = d;
+          } else if (d < d2) {
+            d2 = d;
+          }
+        }
+        inside = d1 + d2 <= closed_gap;
+      }
       if (!inside) return false;
     }
   }
   return true;
+}
+
+// The largest expansion e in [0, cap] [m] of one side of `base` (`side` points at the member: front,
+// rear, left or right) with which footprint_in_lanes still holds at `pose`, by bisection to 0.1 mm;
+// -1 when `base` itself is not inside.
+inline double side_gap(const Footprint& base, double Footprint::*side, const Pose2& pose,
+                       const std::vector<Polygon>& lanes, double cap) {
+  const auto inside = [&](double e) {
+    Footprint f = base;
+    f.*side += e;
+    return footprint_in_lanes(f, pose, lanes);
+  };
+  if (!inside(0.0)) return -1.0;
+  if (inside(cap)) return cap;
+  double lo = 0.0;
+  double hi = cap;
+  while (hi - lo > 1e-4) {
+    const double mid = 0.5 * (lo + hi);
+    (inside(mid) ? lo : hi) = mid;
+  }
+  return lo;
 }
 
 // The rectangle front/rear/left/right [m] around base_link at `pose`, counter-clockwise; written
@@ -202,6 +243,42 @@ inline bool overlaps_grid(const OccupancyGrid& g, int threshold, const Polygon& 
     }
   }
   return false;
+}
+
+// The footprint the geometric planner keeps inside the lanes from `start` (its rule, restated
+// here with the oracle's own gap measurement on the raw lane polygons): lane_departure_margin m on
+// the road side (towards `end`); at the front and the rear m, or the start's gap there if smaller;
+// on the kerb side the start's gap g less the swing s of the rear corner on a first arc at R_min,
+// less 1 cm, within [min(lane_departure_check_expansion_margin, m), m]. 2 mm are left for the two
+// bisections.
+inline Footprint geometric_lane_footprint(const VehicleInfo& v, const LanePlannerParameters& p, const Pose2& start,
+                                          const Pose2& end, const std::vector<Polygon>& all_lanes) {
+  const double m = p.lane_departure_margin;
+  // The gaps are measured up to m + 1 m: only the lanes within reach of the footprint count.
+  const double reach = vehicle_footprint(v).bounding_radius() + m + 2.0;
+  std::vector<Polygon> lanes;
+  for (const Polygon& l : all_lanes) {
+    double d = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < l.size(); ++i)
+      d = std::min(d, point_segment(to_vec(start), l[i], l[(i + 1) % l.size()]));
+    if (d <= reach || point_in_polygon(l, to_vec(start))) lanes.push_back(l);
+  }
+  const Footprint plain = vehicle_footprint(v);
+  Footprint f = plain;
+  f.front += std::max(0.0, side_gap(plain, &Footprint::front, start, lanes, m));
+  f.rear += std::max(0.0, side_gap(plain, &Footprint::rear, start, lanes, m));
+  const double lateral_of_end = -std::sin(start.yaw) * (end.x - start.x) + std::cos(start.yaw) * (end.y - start.y);
+  double Footprint::*road = lateral_of_end > 0.0 ? &Footprint::left : &Footprint::right;
+  double Footprint::*kerb = lateral_of_end > 0.0 ? &Footprint::right : &Footprint::left;
+  const double r_min =
+      v.wheel_base_m / std::tan(v.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale);
+  const double gap = std::max(0.0, side_gap(f, kerb, start, lanes, m + 1.0));
+  const double u = r_min + plain.*kerb;
+  const double swing = std::hypot(u, f.rear) - u;
+  const double floor = std::min(p.lane_departure_check_expansion_margin, m);
+  f.*kerb += std::max(0.0, std::clamp(gap - swing - 0.01, floor, m) - 2e-3);
+  f.*road += m;
+  return f;
 }
 
 inline double direction_of(const PathWithLaneId& seg) {

@@ -34,7 +34,13 @@ using namespace oracle;  // NOLINT: the test's own helpers
 
 // Shoulders passing at every possible start yaw, as measured when this test was written.
 constexpr std::size_t kShiftShoulderFloor = 40;
-constexpr std::size_t kGeometricShoulderFloor = 24;
+constexpr std::size_t kGeometricShoulderFloor = 37;
+
+// [m] Neighbouring lanelets of these maps are sometimes a few centimetres apart instead of
+// sharing a bound (675 and 676 on the road_shoulder map: 4.8 cm); the lane world joins lanes whose
+// edges are within 5 cm (its shared-edge probe), and so does the oracle: a point in a gap between
+// two lanelets at most this wide counts as inside.
+constexpr double kClosedGap = 0.05;
 
 const std::string kMap = std::string(PULLOUT_SOURCE_DIR) + "/../shared/maps/autoware_road_shoulder/lanelet2_map.osm";
 
@@ -44,19 +50,26 @@ struct Verdict {
 };
 
 // The path is inside the map's road and shoulder lanelets (expanded footprint as the planner's
-// own lane check) and turns no tighter than the vehicle can, up to the end pose.
+// own lane check; for geometric, the oracle's geometric_lane_footprint from the first forward
+// segment's start) and turns no tighter than the vehicle can, up to the end pose.
 std::string oracle_problem(const PullOutPath& path, const std::vector<Polygon>& lanes, const VehicleInfo& vehicle,
                            const StartPlannerParameters& params) {
-  const double expansion = path.planner_type == PlannerType::kGeometric ? params.lane_departure_margin
-                                                                        : params.lane_departure_check_expansion_margin;
-  const Footprint fp = vehicle_footprint(vehicle, expansion);
+  Footprint fp = vehicle_footprint(vehicle, params.lane_departure_check_expansion_margin);
+  if (path.planner_type == PlannerType::kGeometric) {
+    for (const auto& seg : path.partial_paths) {
+      if (direction_of(seg) > 0.0 && !seg.points.empty()) {
+        fp = geometric_lane_footprint(vehicle, params, seg.points.front().pose, path.end_pose, lanes);
+        break;
+      }
+    }
+  }
   const double k_max = 1.0 / vehicle.min_turning_radius_m();
   for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
     const auto& points = path.partial_paths[k].points;
     if (points.size() < 2) return "segment " + std::to_string(k) + " has fewer than 2 points";
     for (std::size_t i = 0; i < points.size(); ++i) {
       const Pose2& pose = points[i].pose;
-      if (!footprint_in_lanes(fp, pose, lanes)) {
+      if (!footprint_in_lanes(fp, pose, lanes, kClosedGap)) {
         return "oracle: lane departure at segment " + std::to_string(k) + " point " + std::to_string(i);
       }
       if (i > 0 && i + 1 < points.size()) {
@@ -199,6 +212,11 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
   // vehicle stood beside a corner of the road's centerline polyline).
   for (PlannerType type : {PlannerType::kShift, PlannerType::kGeometric}) {
     for (const auto& f : failures[type]) EXPECT_EQ(f.find("does not start at the vehicle"), std::string::npos) << f;
+    // Every path the planner's own lane check accepts is inside the lanelets by the oracle too
+    // (4 shift paths on shoulders 534 and 678 crossed a 4.8 cm gap between lanelets 675 and 676
+    // that the lane world joins; the oracle now closes such gaps too, kClosedGap). The oracle's
+    // curvature findings (shoulders 534, 678, 10988-10997) are reported, not asserted.
+    for (const auto& f : failures[type]) EXPECT_EQ(f.find("oracle: lane departure"), std::string::npos) << f;
   }
 }
 

@@ -1,15 +1,19 @@
 // Generated families of parallel parking spots on a single-lane street: a 3 m parking lane beside
 // ONE 3.5 m road lane (no opposite lane to swing into), right-hand traffic (parking lane on the
 // right, the vehicle pulls out to the left) and left-hand traffic (parking lane on the left,
-// pulling out to the right), the vehicle 0.3-0.5 m from the kerb between two parked cars with
+// pulling out to the right), the vehicle 0.15-0.5 m from the kerb between two parked cars with
 // 0.5-4 m free ahead and behind. The geometric planner runs alone (freespace off).
 //
 // Expectation (a driver's, stated as plain geometry in this file, not taken from the planner):
 // after reversing as far as the car behind allows (to `kSmallestMargin` from it), the first move
 // is a full-lock arc towards the road - at the radius R_min, or, when the rear corner on the kerb
-// side would swing over the kerb's lane edge less lane_departure_margin, at the smallest radius
-// whose swing fits. The outer front corner (on the kerb side) circles the arc's centre at
-// hypot(front, R + half width), and passes the car ahead's rear corner on the road side; it
+// side would swing over the kerb's lane edge less the kerb-side margin, at the smallest radius
+// whose swing fits. The kerb-side margin is lane_departure_margin m where the room beside the car
+// allows it, and yields to what a car parked closer needs: with g the gap to the kerb and s the
+// swing of the rear corner (behind the rear by m) at R_min,
+//   m_kerb = clamp(g - s - 1 cm, 0, m)
+// (a car 0.15 m from the kerb is not asked for 0.2 m; the road side keeps m). The outer front corner (on the kerb side)
+// circles the arc's centre at hypot(front, R + half width), and passes the car ahead's rear corner on the road side; it
 // clears that corner by kSmallestMargin when the room ahead g (after reversing) satisfies
 //   (front + g)^2 + (R - w_car / 2)^2 >= (hypot(front, R + w) + kSmallestMargin)^2.
 // Spots with g above that bound plus kFindTolerance must give a path; spots with g below it
@@ -17,7 +21,8 @@
 // between the two no claim is made.
 //
 // Every path found is checked by independent oracles written here: the footprint rectangle
-// (expanded by lane_departure_margin) inside the street's lane rectangle, the plain footprint
+// (expanded by lane_departure_margin, on the kerb side by m_kerb) inside the street's lane
+// rectangle, the plain footprint inside the raw lane polygons (path_oracles.hpp), the plain footprint
 // at least kSmallestMargin (less the chord tolerance) from both cars' rectangles, at poses
 // interpolated every 5 cm along every partial path; a stop (velocity 0) at the end of every
 // partial path but the last (the reverse leg, the stop to re-steer between the arcs); one pair
@@ -170,15 +175,27 @@ StartPlannerParameters family_parameters() {
 
 // Room [m] between the front bumper and the car ahead after reversing as far as the car behind
 // allows, less the room the first full-lock arc's outer front corner needs to clear it.
+double r_min_of(const VehicleInfo& v, const StartPlannerParameters& p) {
+  return v.wheel_base_m / std::tan(v.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale);
+}
+
+// The margin the lane check keeps from the kerb (see the file comment).
+double kerb_margin(const Spot& s, const VehicleInfo& v, const StartPlannerParameters& p) {
+  const double m = p.lane_departure_margin;
+  const double u = r_min_of(v, p) + (s.right_hand ? v.base_to_right_m() : v.base_to_left_m());
+  const double swing = std::hypot(u, v.base_to_rear_m() + m) - u;
+  return std::clamp(s.kerb - swing - 0.01, 0.0, m);
+}
+
 double spare_room(const Spot& s, const VehicleInfo& v, const StartPlannerParameters& p) {
   const double m = p.lane_departure_margin;
-  const double r_min =
-      v.wheel_base_m / std::tan(v.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale);
-  // The kerb-side rear corner of the footprint expanded by m swings towards the kerb by
-  // hypot(R + w, rear) - (R + w); it has `room` before the kerb-side lane edge.
-  const double w_kerb = (s.right_hand ? v.base_to_right_m() : v.base_to_left_m()) + m;
+  const double r_min = r_min_of(v, p);
+  // The kerb-side rear corner of the footprint expanded by m (by m_kerb sideways) swings towards
+  // the kerb by hypot(R + w, rear) - (R + w); it has `room` before the kerb-side lane edge.
+  const double mk = kerb_margin(s, v, p);
+  const double w_kerb = (s.right_hand ? v.base_to_right_m() : v.base_to_left_m()) + mk;
   const double rear = v.base_to_rear_m() + m;
-  const double room = s.kerb - m;
+  const double room = s.kerb - mk;
   double r = r_min;
   while (std::hypot(r + w_kerb, rear) - (r + w_kerb) > room) r += 0.01;  // plain search, 1 cm
   const double w = s.right_hand ? v.base_to_right_m() : v.base_to_left_m();
@@ -193,7 +210,7 @@ double spare_room(const Spot& s, const VehicleInfo& v, const StartPlannerParamet
 std::vector<Spot> family() {
   std::vector<Spot> spots;
   for (bool right_hand : {true, false}) {
-    for (double kerb : {0.3, 0.4, 0.5}) {
+    for (double kerb : {0.15, 0.2, 0.25, 0.3, 0.4, 0.5}) {
       for (double ahead : {0.5, 1.0, 1.5, 2.0, 3.0, 4.0}) {
         for (double behind : {0.5, 1.0, 1.5, 2.0, 3.0, 4.0}) spots.push_back({right_hand, kerb, ahead, behind});
       }
@@ -211,7 +228,7 @@ double direction(const PathWithLaneId& seg) {
 }
 
 // The oracle's verdict on a found path; empty when it is drivable.
-std::string check_path(const PullOutPath& path, const Street& st, const VehicleInfo& v,
+std::string check_path(const PullOutPath& path, const Spot& s, const Street& st, const VehicleInfo& v,
                        const StartPlannerParameters& p) {
   if (path.planner_type != PlannerType::kGeometric) return "planner " + std::string(to_string(path.planner_type));
   const auto& segs = path.partial_paths;
@@ -233,12 +250,19 @@ std::string check_path(const PullOutPath& path, const Street& st, const VehicleI
   const Pose2 end = segs.back().points.back().pose;
   if (std::abs(end.y) > 0.05 || std::abs(std::remainder(end.yaw, 2.0 * kPi)) > 0.02) return "does not end on the road";
   const double m = p.lane_departure_margin - kChordTolerance;
+  const double mk = std::max(0.0, kerb_margin(s, v, p) - kChordTolerance);
   const double left = v.base_to_left_m();
   const double right = v.base_to_right_m();
+  const std::vector<Polygon> lane_polygons{oracle::lane_polygon(st.request.lanes[0]),
+                                           oracle::lane_polygon(st.request.lanes[1])};
+  const Footprint plain{v.base_to_front_m(), v.base_to_rear_m(), left, right};
   for (std::size_t i = 0; i < segs.size(); ++i) {
     for (const Pose2& q : oracle::poses_along(segs[i], 0.05)) {  // every 5 cm at most
-      const Quad lanes_fp =
-          rectangle(q.x, q.y, q.yaw, v.base_to_front_m() + m, v.base_to_rear_m() + m, left + m, right + m);
+      if (!oracle::footprint_in_lanes(plain, q, lane_polygons)) {
+        return "segment " + std::to_string(i) + ": footprint outside the lane polygons at x " + std::to_string(q.x);
+      }
+      const Quad lanes_fp = rectangle(q.x, q.y, q.yaw, v.base_to_front_m() + m, v.base_to_rear_m() + m,
+                                      left + (s.right_hand ? m : mk), right + (s.right_hand ? mk : m));
       for (const Vec2& c : lanes_fp) {
         if (c.x() < 0.0 || c.x() > kStreetLength || c.y() < st.y_min || c.y() > st.y_max) {
           return "segment " + std::to_string(i) + ": footprint corner (" + std::to_string(c.x()) + ", " +
@@ -275,12 +299,12 @@ TEST(GeometricSingleLaneStreet, PullsOutOfEveryParallelSpotADriverWould) {
     const double spare = spare_room(s, v, p);
     const bool found = r.outcome == PlanningResult::Outcome::kFound;
     if (found) {
-      const std::string verdict = check_path(r.path, st, v, p);
+      const std::string verdict = check_path(r.path, s, st, v, p);
       EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
     }
     if (spare >= kFindTolerance) {
       const std::string name =
-          std::string(s.right_hand ? "right-hand" : "left-hand") + " kerb " + std::to_string(s.kerb).substr(0, 3);
+          std::string(s.right_hand ? "right-hand" : "left-hand") + " kerb " + std::to_string(s.kerb).substr(0, 4);
       auto it = std::find_if(per_family.begin(), per_family.end(), [&name](const auto& f) { return f.first == name; });
       if (it == per_family.end()) it = per_family.insert(per_family.end(), {name, {0, 0}});
       it->second[0] += found ? 1 : 0;

@@ -138,12 +138,22 @@ TEST_P(PlannerProperties, FoundPathsAreDrivable) {
   // for freespace, the footprint grown by half of vehicle_shape_margin is clear of every occupied
   // cell, and the costmap marks every cell an object touches, so the body keeps that distance.
   const double margin = freespace ? 0.5 * fp.vehicle_shape_margin : r.evaluation_table.back().margin_m;
-  // The footprint that must stay inside the lanes: the lane planners' departure expansion; the
-  // freespace costmap frees only cells entirely inside the lanes.
+  // The footprint that must stay inside the lanes: the lane planners' departure expansion (for
+  // geometric, see geometric_lane_footprint); the freespace costmap frees only cells entirely
+  // inside the lanes.
   const double expansion = freespace                              ? 0.5 * fp.vehicle_shape_margin
                            : c.planner == PlannerType::kGeometric ? params.lane_departure_margin
                                                                   : params.lane_departure_check_expansion_margin;
-  const Footprint lane_footprint = vehicle_footprint(sc.vehicle, expansion);
+  Footprint lane_footprint = vehicle_footprint(sc.vehicle, expansion);
+  if (c.planner == PlannerType::kGeometric) {
+    // The geometric part starts at the first forward segment (after a reverse leg, if any).
+    for (const auto& seg : path.partial_paths) {
+      if (direction_of(seg) > 0.0) {
+        lane_footprint = geometric_lane_footprint(sc.vehicle, params, seg.points.front().pose, path.end_pose, lanes);
+        break;
+      }
+    }
+  }
   // Where the margin applies: up to the end pose, plus 10 m for shift
   // (shift_collision_check_distance_from_end); beyond that only contact is excluded.
   const double margin_until_end =

@@ -15,6 +15,8 @@ namespace {
 constexpr double kTrimDistance = 1.0;  // [m] Autoware's trim around the end pose
 constexpr double kSamePose = 1e-6;     // [m]
 constexpr double kWindowExtra = 10.0;  // [m] costmap window beyond the farthest end pose
+constexpr int kRoomBisections = 12;    // a shape margin of up to a few metres to about 1 mm
+constexpr double kRoomSlack = 0.01;    // [m] left between the start and what its margin reaches
 
 // The pair of a partial path that stops at its end: v reached at half of it (a = v^2 / L).
 TerminalVelocityAccel stopping_pair(double v, double length) {
@@ -67,6 +69,56 @@ double freespace_window_half_size(const FreespaceParameters& p, const VehicleInf
 
 Footprint freespace_footprint(const VehicleInfo& vehicle, const FreespaceParameters& p) {
   return vehicle_footprint(vehicle, 0.5 * p.vehicle_shape_margin);
+}
+
+Footprint freespace_footprint(const VehicleInfo& vehicle, const FreespaceParameters& p, const Costmap& costmap,
+                              const Pose2& start) {
+  const Footprint plain = vehicle_footprint(vehicle);
+  const double half = 0.5 * p.vehicle_shape_margin;
+  // The room [m] of one side at the start, up to `cap`: the largest growth of that side alone
+  // with which the start is still free (bisection on the exact checker), less kRoomSlack.
+  const auto room = [&](double Footprint::*side, double cap) {
+    const auto free_with = [&](double e) {
+      Footprint f = plain;
+      f.*side += e;
+      return !GridCollisionChecker(costmap, f).collides(start);
+    };
+    if (free_with(cap + kRoomSlack)) return cap;
+    if (!free_with(0.0)) return 0.0;
+    double lo = 0.0;
+    double hi = cap + kRoomSlack;
+    for (int i = 0; i < kRoomBisections; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (free_with(mid) ? lo : hi) = mid;
+    }
+    return std::max(0.0, lo - kRoomSlack);
+  };
+  // A full-lock forward turn away from a side swings the rear corner on that side outwards by
+  // hypot(R + w, rear) - (R + w) (R the search's turning radius): the side's margin leaves room
+  // for that swing, and the rear's margin is kept small enough that its corners' swing fits.
+  const double r = freespace_search_config(vehicle, p).turning_radius;
+  const auto swing = [r](double across, double rear) { return std::hypot(r + across, rear) - (r + across); };
+  const double swing_cap = half + 1.0;  // beyond any swing at a turning radius of a few metres
+  // The search covers the motion between its poses with the footprint grown by up to a quarter
+  // of a cell (hybrid_astar.hpp): the swing leaves that much too.
+  const double sweep = 0.25 * costmap.resolution();
+  const double side_room = std::min(room(&Footprint::left, swing_cap), room(&Footprint::right, swing_cap)) - sweep;
+  const double half_width = std::min(plain.left, plain.right);
+  Footprint out = plain;
+  out.front += room(&Footprint::front, half);
+  double rear = room(&Footprint::rear, half);
+  // Largest rear growth whose corner's swing fits the narrower side's room.
+  const double u = r + half_width;
+  if (swing(half_width, plain.rear + rear) > side_room) {
+    const double fit = std::sqrt(std::max(0.0, (u + side_room) * (u + side_room) - u * u));
+    rear = std::clamp(fit - plain.rear, 0.0, rear);
+  }
+  out.rear += rear;
+  const double lateral_swing = swing(half_width, out.rear);
+  for (double Footprint::*side : {&Footprint::left, &Footprint::right}) {
+    out.*side += std::clamp(room(side, swing_cap) - sweep - lateral_swing, 0.0, half);
+  }
+  return out;
 }
 
 Costmap freespace_costmap(const FreespaceParameters& p, const OccupancyGrid* grid, const LaneWorld* world,
@@ -154,7 +206,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
   const Costmap costmap = freespace_costmap(p, ctx.occupancy_grid, &ctx.world, obstacles, ctx.ego, half_window, until);
   out.stopped = costmap.stopped();
   if (out.stopped != StopReason::kNone) return out;
-  const GridCollisionChecker checker(costmap, freespace_footprint(ctx.vehicle, p));
+  const GridCollisionChecker checker(costmap, freespace_footprint(ctx.vehicle, p, costmap, start));
   const HybridAStar search(checker, freespace_search_config(ctx.vehicle, p));
 
   const Polyline& center = ctx.road.centerline;

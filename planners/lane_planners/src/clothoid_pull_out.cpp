@@ -46,7 +46,7 @@ PlannerCandidates ClothoidPullOut::plan(const PlanningContext& ctx, const Pose2&
     };
     TurnCandidateOptions options;
     options.check_lanes = p.check_clothoid_path_lane_departure;
-    options.departure_expansion = p.lane_departure_check_expansion_margin;
+    options.departure_footprint = vehicle_footprint(ctx.vehicle, p.lane_departure_check_expansion_margin);
     options.collision_distance_from_end = p.clothoid_collision_check_distance_from_end;
     options.output_interval = p.center_line_path_interval;
     out.candidates.push_back(make_turn_candidate(ctx, *turns, options, velocity, segment));

@@ -16,6 +16,12 @@ constexpr int kEndOffsets = 10;  // 0..9 m, as Autoware's end-pose offsets
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 constexpr double kEdgeReach = 50.0;  // [m] outline pieces this close to the start are looked at
+// [m] How far beyond lane_departure_margin the room on the kerb side is measured (more than any
+// first arc's swing).
+constexpr double kKerbReach = 1.0;
+// [m] Left between the swing of a first arc at R_min and the kerb-side margin that yields to it.
+constexpr double kSwingSlack = 0.01;
+constexpr int kClearanceBisections = 14;  // a bracket of 1.2 m shrinks below 0.1 mm
 
 using Edges = std::vector<std::pair<Vec2, Vec2>>;
 
@@ -61,6 +67,26 @@ double corner_swing(double r, double along, double across, double turn) {
   return (turn >= peak ? radius : radius * std::cos(peak - turn)) - u;
 }
 
+// The largest expansion [m], up to `cap`, of the side `side` of `base` with which the footprint
+// at `pose` stays inside the lanes (bisection); -1 when `base` itself does not.
+double side_clearance(const LaneWorld& world, const Footprint& base, double Footprint::*side, const Pose2& pose,
+                      double cap) {
+  const auto inside = [&](double e) {
+    Footprint f = base;
+    f.*side += e;
+    return world.footprint_inside(footprint_corners(f, pose));
+  };
+  if (!inside(0.0)) return -1.0;
+  if (inside(cap)) return cap;
+  double lo = 0.0;
+  double hi = cap;
+  for (int i = 0; i < kClearanceBisections; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (inside(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
 }  // namespace
 
 PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2& start,
@@ -73,17 +99,34 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
   const Polyline window = turn_window(ctx, start);
   const double v = p.geometric_pull_out_velocity;
 
-  // The footprint as the lane check sees it (expanded by lane_departure_margin).
-  const Footprint fp = vehicle_footprint(ctx.vehicle, p.lane_departure_margin);
+  // The footprint the lane check keeps inside the lanes (see the header): lane_departure_margin
+  // on the road side; at the front and the rear as much of it as the start pose has; on the kerb
+  // side as much as the start has beyond the swing of a first arc at R_min, never less than
+  // lane_departure_check_expansion_margin.
+  const double margin = p.lane_departure_margin;
+  const double kerb_floor = std::min(p.lane_departure_check_expansion_margin, margin);
+  const Footprint plain = vehicle_footprint(ctx.vehicle);
   const Polyline& center = ctx.road.centerline;
   const auto start_on_road = center.project(to_vec(start));
   const double side = start_on_road.lateral < 0.0 ? 1.0 : -1.0;  // +1: the road is to the left
-  const Vec2 start_normal = left_normal(heading(start.yaw));
+  double Footprint::*const road_side = side > 0.0 ? &Footprint::left : &Footprint::right;
+  double Footprint::*const kerb_side = side > 0.0 ? &Footprint::right : &Footprint::left;
+  Footprint fp = plain;
+  fp.front += std::max(0.0, side_clearance(ctx.world, plain, &Footprint::front, start, margin));
+  fp.rear += std::max(0.0, side_clearance(ctx.world, plain, &Footprint::rear, start, margin));
+  // Room beside the kerb side at the start (with the front and rear margins: the corners count).
+  const double kerb_cap = margin + kKerbReach;
+  const double kerb_gap = std::max(0.0, side_clearance(ctx.world, fp, kerb_side, start, kerb_cap));
+  const double swing_at_r_min = corner_swing(r_min, fp.rear, plain.*kerb_side, kPi);
+  const double kerb_margin = std::clamp(kerb_gap - swing_at_r_min - kSwingSlack, kerb_floor, margin);
+  fp.*road_side += margin;
+  fp.*kerb_side += kerb_margin;
   const Edges edges = edges_near(ctx.world, to_vec(start));
-  const double road_side_half_width = side > 0.0 ? fp.left : fp.right;
-  const double kerb_side_half_width = side > 0.0 ? fp.right : fp.left;
-  // Room between the footprint and the lane edge on the kerb side, at the start.
-  const double kerb_room = distance_to_lane_edge(edges, to_vec(start), -side * start_normal) - kerb_side_half_width;
+  const double road_side_half_width = fp.*road_side;
+  const double kerb_side_half_width = fp.*kerb_side;
+  // Room between the lane-check footprint and the lane edge on the kerb side, at the start
+  // (unbounded when no edge is within reach).
+  const double kerb_room = kerb_gap >= kerb_cap ? kInfinity : kerb_gap - kerb_margin;
   // The first arc (around a centre on the road side) swings the rear corner on the kerb side
   // outwards by up to hypot(R + w, rear) - (R + w). R_min unless that crosses the kerb-side edge;
   // then the smallest radius whose swing fits: hypot(u, rear) <= u + room, u = R + w.
@@ -169,7 +212,7 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
     };
     TurnCandidateOptions options;
     options.check_lanes = true;
-    options.departure_expansion = p.lane_departure_margin;
+    options.departure_footprint = fp;
     options.collision_distance_from_end = p.geometric_collision_check_distance_from_end;
     options.output_interval = p.arc_path_interval;
     const auto velocity = [divide, first_turn_length, v, v1](double d) {

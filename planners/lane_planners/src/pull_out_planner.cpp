@@ -156,8 +156,7 @@ Selection select_candidate(const PlannerCandidates& pc, double margin) {
 }
 
 std::optional<std::size_t> first_lane_departure(const PlanningContext& ctx, const std::vector<Pose2>& poses,
-                                                std::size_t first, std::size_t last, double expansion) {
-  const Footprint fp = vehicle_footprint(ctx.vehicle, expansion);
+                                                std::size_t first, std::size_t last, const Footprint& fp) {
   for (std::size_t i = first; i <= last && i < poses.size(); ++i) {
     if (!ctx.world.footprint_inside(footprint_corners(fp, poses[i]))) return i;
   }
@@ -194,7 +193,7 @@ void check_candidate(const PlanningContext& ctx, const std::vector<Pose2>& poses
       return;
     }
   }
-  if (checks.check_lanes && first_lane_departure(ctx, poses, 0, checks.departure_last, checks.expansion)) {
+  if (checks.check_lanes && first_lane_departure(ctx, poses, 0, checks.departure_last, checks.departure_footprint)) {
     candidate.rejection = Failure{AttemptOutcome::kLaneDeparture, ""};
   }
 }

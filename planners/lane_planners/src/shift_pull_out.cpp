@@ -260,8 +260,9 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
   // Lane departure is checked unless disabled, or (override) unless the vehicle already stands
   // partly outside the lanes.
   bool check_lanes = params.check_shift_path_lane_departure;
+  const Footprint departure_footprint = vehicle_footprint(ctx.vehicle, params.lane_departure_check_expansion_margin);
   if (check_lanes && params.allow_check_shift_path_lane_departure_override) {
-    check_lanes = !first_lane_departure(ctx, {start}, 0, 0, params.lane_departure_check_expansion_margin).has_value();
+    check_lanes = !first_lane_departure(ctx, {start}, 0, 0, departure_footprint).has_value();
   }
 
   for (const ShiftKinematics& k : kinematics) {
@@ -294,7 +295,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
     std::size_t section_last = 0;
     while (section_last + 1 < c->s.size() && c->s[section_last + 1] <= s_check_end) ++section_last;
     check_candidate(ctx, c->poses,
-                    {check_lanes, params.lane_departure_check_expansion_margin, c->shift_end_index, section_last,
+                    {check_lanes, departure_footprint, c->shift_end_index, section_last,
                      std::max(section_last, c->shift_end_index)},
                     candidate);
     candidate.build = [&ctx, c, end, k, shift_length]() {

@@ -121,7 +121,7 @@ PathCandidate make_turn_candidate(
     }
     section_last = poses.size() - 1;
   }
-  check_candidate(ctx, poses, {options.check_lanes, options.departure_expansion, turns_last, section_last, turns_last},
+  check_candidate(ctx, poses, {options.check_lanes, options.departure_footprint, turns_last, section_last, turns_last},
                   candidate);
   if (!candidate.rejection) {
     // The sampled clearance over the turns, made exact (see refined_clearance). A rejected

@@ -10,7 +10,7 @@ namespace pullout {
 
 struct TurnCandidateOptions {
   bool check_lanes{true};
-  double departure_expansion{0.0};          // [m] footprint expansion for the lane check
+  Footprint departure_footprint;            // the footprint the lane check keeps inside the lanes
   double collision_distance_from_end{0.0};  // [m] collision section end relative to the end pose
   double output_interval{1.0};              // [m] point spacing on the turns
 };

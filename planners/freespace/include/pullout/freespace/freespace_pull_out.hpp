@@ -7,8 +7,12 @@
 //    unknown are obstacles), else the lanes (drivable) and the static objects rasterised at
 //    costmap_configs.resolution over a window around the vehicle; static objects are added to a
 //    grid too;
-//  - vehicle: the footprint grown by vehicle_shape_margin (half on each side), steering limited
-//    to max_steer_angle x max_turning_ratio;
+//  - vehicle: the footprint grown by vehicle_shape_margin (half on each side) where the start
+//    pose allows it: each side grows by half the margin, or by the room the start has on that
+//    side less 1 cm when that is less (a car 0.15 m from the kerb, 0.4 m from the car ahead).
+//    Autoware's default margin (1.0 m, meant for open lots) otherwise puts the start of a car
+//    parked at a kerb in collision; the search keeps the clamped margin everywhere. Steering
+//    limited to max_steer_angle x max_turning_ratio;
 //  - end poses: on the road centerline from s(ego) + end_pose_search_start_distance to
 //    s(ego) + end_pose_search_end_distance every end_pose_search_interval; the first one reached
 //    wins;
@@ -50,6 +54,10 @@ class FreespacePullOut : public PullOutPlanner {
 HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const FreespaceParameters& parameters);
 // The vehicle footprint grown by vehicle_shape_margin (half on each side).
 Footprint freespace_footprint(const VehicleInfo& vehicle, const FreespaceParameters& parameters);
+// The same, each side's growth clamped to the room the footprint has on that side at `start` on
+// `costmap` less 1 cm (never below 0): the pull-out's footprint (see the file comment).
+Footprint freespace_footprint(const VehicleInfo& vehicle, const FreespaceParameters& parameters, const Costmap& costmap,
+                              const Pose2& start);
 
 // [m] Half the side of the costmap's square window around the vehicle: the farthest end pose,
 // the vehicle's length and 10 m more.

@@ -21,8 +21,19 @@
 // two turns at R_min joined by a common tangent of the offset's length (the same way or opposite
 // ways, solve_two_turn).
 //
-// Lane departure: the footprint, expanded by lane_departure_margin, must stay inside the lanes
-// (in the analytic check and in the footprint check over the arcs, every 0.5 m).
+// Lane departure: a footprint expanded per side must stay inside the lanes (in the analytic check
+// and in the footprint check over the arcs, every 0.5 m). The road side (towards the end pose) is
+// expanded by lane_departure_margin m, always. The front and the rear by m, or by the start pose's
+// own clearance there when that is smaller: a start is never required to be further inside the
+// lanes than it already is. The kerb side by
+//   m_kerb = clamp(g - s - 1 cm, min(lane_departure_check_expansion_margin, m), m),
+// g the start's clearance on the kerb side (measured with the front and rear expansions, so the
+// corners count), s the swing of the expanded rear corner on a first arc at R_min: the margin
+// stays whole where the room beside the car allows it, and yields, down to Autoware's footprint
+// check (expansion 0 by default), to what the tightest first turn needs in a car parked closer
+// (0.15-0.3 m from the kerb is how cars are parked). Below that the first arc widens (above).
+// Autoware checks the footprint unexpanded and the kerb-side swing with the whole margin, so its
+// geometric pull-out fails from a car parked within about 0.3 m of the kerb.
 //
 // divide_pull_out_path = true: two partial paths, split at the end of the first arc where the
 // vehicle stops to re-steer, when the arcs turn opposite ways (an S); false, or two arcs turning

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/lane_planners/lane_planner_parameters.hpp"
 #include "pullout/lanes/lane_world.hpp"
@@ -94,22 +95,22 @@ Failure stopped_failure(StopReason reason);
 
 // ---- checks shared by the planners ----
 
-// Index of the first pose in [first, last] whose footprint, expanded by `expansion` [m], leaves
-// the union of the lanes.
+// Index of the first pose in [first, last] whose footprint `footprint` (the vehicle's, each side
+// expanded as the planner's lane check requires) leaves the union of the lanes.
 std::optional<std::size_t> first_lane_departure(const PlanningContext& context, const std::vector<Pose2>& poses,
-                                                std::size_t first, std::size_t last, double expansion);
+                                                std::size_t first, std::size_t last, const Footprint& footprint);
 
 // Clearance over poses [first, last] (see PathCandidate::clearance).
 ObjectChecker::Clearance section_clearance(const PlanningContext& context, const std::vector<Pose2>& poses,
                                            std::size_t first, std::size_t last);
 
 // Fills candidate.rejection / clearance from the standard checks: lane departure over
-// [0, departure_last] with the footprint expanded by `expansion` (when `check_lanes`; rejection
+// [0, departure_last] of `departure_footprint` (when `check_lanes`; rejection
 // kLaneDeparture), clearance over [0, section_last], and no contact at all over
 // (section_last, contact_last] (rejection kCollision, detail naming the object).
 struct CandidateChecks {
   bool check_lanes{true};
-  double expansion{0.0};
+  Footprint departure_footprint;
   std::size_t departure_last{0};
   std::size_t section_last{0};
   std::size_t contact_last{0};

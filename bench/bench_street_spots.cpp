@@ -1,0 +1,233 @@
+// Generated families of parallel parking spots (issue 12): the vehicle 0.15-0.5 m from the kerb
+// between two parked cars with a total slack of 3.0 down to 0.8 m (split evenly ahead and
+// behind); one road lane (a one-way street) or two (an opposite lane beyond); right-hand traffic
+// (parking lane on the right) and left-hand (on the left); a straight street and streets curving
+// left with centerline radius 30, 100 and 200 m (the parking lane on the outside of the bend for
+// right-hand traffic, on the inside for left-hand). Per family and per planner: spots solved,
+// direction changes of the paths, planning time p50 / p95. Every path found is checked by the
+// independent oracles (tests/planners/path_oracles.hpp): the bare body inside the raw lane
+// polygons and clear of both cars at poses every 5 cm, velocity 0 at each change of direction, one
+// pair per partial path; a path that fails them counts as not solved (and is reported).
+//
+//   build/bench/bench_street_spots
+//
+// Planners: shift alone, geometric alone (each with the backward search, freespace off) and the
+// shipped search (shift, geometric, freespace fallback; freespace_planner.time_limit 1000 ms to
+// bound the run). collision_check_margin_from_front_object is 0 for all (Autoware's 5 m skips
+// every backward candidate in a parallel spot). Results in bench/RESULTS.md.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "path_oracles.hpp"
+#include "percentiles.hpp"
+#include "pullout/model/names.hpp"
+#include "pullout/pipeline/start_planner.hpp"
+
+namespace {
+
+using namespace pullout;  // NOLINT: a benchmark's main file
+
+constexpr double kLaneWidth = 3.5;
+constexpr double kParkingWidth = 3.0;
+constexpr double kStreetLength = 120.0;
+constexpr double kEgoS = 40.0;
+
+struct Spot {
+  bool right_hand;
+  int road_lanes;
+  double radius;  // 0: straight
+  double kerb;
+  double slack;
+};
+
+// The street frame (s along the road centerline of the vehicle's lane, y to its left) to the map.
+Pose2 at(const Spot& sp, double s, double y) {
+  if (sp.radius <= 0.0) return {s, y, 0.0};
+  const double th = s / sp.radius;
+  return {(sp.radius - y) * std::sin(th), sp.radius - (sp.radius - y) * std::cos(th), th};
+}
+
+std::vector<Point2> line(const Spot& sp, double y) {
+  std::vector<Point2> out;
+  for (double s = 0.0; s <= kStreetLength + 1e-9; s += 1.0) {
+    const Pose2 p = at(sp, s, y);
+    out.push_back({p.x, p.y});
+  }
+  return out;
+}
+
+Lane lane(const Spot& sp, std::int64_t id, LaneSubtype subtype, double y_right, double y_left) {
+  Lane l;
+  l.id = id;
+  l.subtype = subtype;
+  l.left_bound = line(sp, y_left);
+  l.right_bound = line(sp, y_right);
+  l.speed_limit_mps = 8.33;
+  return l;
+}
+
+struct Street {
+  PullOutRequest request;
+  std::vector<Polygon> lanes;
+  std::vector<Polygon> cars;
+};
+
+Street make_street(const Spot& sp, const VehicleInfo& v) {
+  Street st;
+  PullOutRequest& r = st.request;
+  r.vehicle_id = "spot";
+  r.request_id = 1;
+  const double h = kLaneWidth / 2;
+  const double side = sp.right_hand ? -1.0 : 1.0;  // where the parking lane is
+  r.lanes.push_back(lane(sp, 1, LaneSubtype::kRoad, -h, h));
+  if (sp.road_lanes == 2) {
+    r.lanes.push_back(sp.right_hand ? lane(sp, 3, LaneSubtype::kRoad, h, h + kLaneWidth)
+                                    : lane(sp, 3, LaneSubtype::kRoad, -h - kLaneWidth, -h));
+  }
+  r.lanes.push_back(sp.right_hand ? lane(sp, 2, LaneSubtype::kRoadShoulder, -h - kParkingWidth, -h)
+                                  : lane(sp, 2, LaneSubtype::kRoadShoulder, h, h + kParkingWidth));
+  const double kerb_y = side * (h + kParkingWidth);
+  const double y = sp.right_hand ? kerb_y + sp.kerb + v.base_to_right_m() : kerb_y - sp.kerb - v.base_to_left_m();
+  r.ego_pose = at(sp, kEgoS, y);
+  r.goal_pose = at(sp, 110.0, 0.0);
+  const double half = sp.slack / 2;
+  const double s_ahead = kEgoS + v.base_to_front_m() + half + 2.25;
+  const double s_behind = kEgoS - v.base_to_rear_m() - half - 2.25;
+  for (auto [id, s] : {std::pair<std::int64_t, double>{7, s_ahead}, {8, s_behind}}) {
+    Object o;
+    o.id = id;
+    o.object_class = ObjectClass::kCar;
+    o.pose = at(sp, s, y);
+    o.length_m = 4.5;
+    o.width_m = 1.9;
+    r.objects.push_back(o);
+    st.cars.push_back(object_polygon(o));
+  }
+  for (const Lane& l : r.lanes) st.lanes.push_back(oracle::lane_polygon(l));
+  return st;
+}
+
+// Empty when the path passes the oracles.
+std::string check(const PullOutPath& path, const Street& st, const VehicleInfo& v) {
+  if (path.pairs_terminal_velocity_and_accel.size() != path.partial_paths.size()) return "pairs";
+  const Footprint body = vehicle_footprint(v);
+  for (std::size_t k = 0; k < path.partial_paths.size(); ++k) {
+    const auto& seg = path.partial_paths[k];
+    if (seg.points.size() < 2) return "short segment";
+    const double dir = oracle::direction_of(seg);
+    if (k + 1 < path.partial_paths.size() && oracle::direction_of(path.partial_paths[k + 1]) != dir &&
+        seg.points.back().longitudinal_velocity_mps != 0.0) {
+      return "no stop at a direction change";
+    }
+    bool beyond_end = false;
+    for (const Pose2& q : oracle::poses_along(seg, 0.05)) {
+      if (!beyond_end && !oracle::footprint_in_lanes(body, q, st.lanes)) return "leaves the lanes";
+      for (const Polygon& c : st.cars) {
+        if (oracle::polygons_overlap(oracle::rectangle_at(body, q), c)) return "touches a car";
+      }
+      // Beyond the end pose the path is the road centerline (checked up to there).
+      if (k + 1 == path.partial_paths.size() && std::hypot(q.x - path.end_pose.x, q.y - path.end_pose.y) < 0.05) {
+        beyond_end = true;
+      }
+    }
+  }
+  return "";
+}
+
+struct Tally {
+  int solved{0};
+  int total{0};
+  int cusps{0};
+  std::vector<double> ms;
+};
+
+}  // namespace
+
+int main() {
+  const VehicleInfo v;
+  struct Planner {
+    const char* name;
+    StartPlannerParameters params;
+  };
+  std::vector<Planner> planners;
+  for (int k = 0; k < 3; ++k) {
+    StartPlannerParameters p;
+    p.collision_check_margin_from_front_object = 0.0;
+    p.freespace_planner.time_limit = 1000.0;
+    if (k == 0) p.search_priority = {PlannerType::kShift};
+    if (k == 1) p.search_priority = {PlannerType::kGeometric};
+    if (k < 2) p.freespace_planner.enable_freespace_planner = false;
+    planners.push_back({k == 0 ? "shift" : k == 1 ? "geometric" : "default search", p});
+  }
+  std::map<std::string, std::map<std::string, Tally>> by_family;  // family -> planner -> tally
+  std::map<std::string, std::map<double, Tally>> by_slack;        // planner -> slack -> tally
+  std::vector<std::string> oracle_failures;
+  for (bool right_hand : {true, false}) {
+    for (int road_lanes : {1, 2}) {
+      for (double radius : {0.0, 30.0, 100.0, 200.0}) {
+        const std::string family = std::string(right_hand ? "right-hand" : "left-hand") + ", " +
+                                   std::to_string(road_lanes) + " lane" + (road_lanes > 1 ? "s" : "") + ", " +
+                                   (radius > 0 ? "R " + std::to_string(static_cast<int>(radius)) + " m" : "straight");
+        for (double kerb : {0.15, 0.3, 0.5}) {
+          for (double slack : {3.0, 2.0, 1.5, 1.0, 0.8}) {
+            const Spot sp{right_hand, road_lanes, radius, kerb, slack};
+            const Street st = make_street(sp, v);
+            for (const Planner& pl : planners) {
+              const StartPlanner planner(v, pl.params);
+              const auto t0 = std::chrono::steady_clock::now();
+              const PlanningResult r = planner.plan(st.request, StopCondition());
+              const double ms =
+                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+              bool ok = r.outcome == PlanningResult::Outcome::kFound;
+              if (ok) {
+                const std::string why = check(r.path, st, v);
+                if (!why.empty()) {
+                  ok = false;
+                  oracle_failures.push_back(std::string(pl.name) + " " + family + " kerb " + std::to_string(kerb) +
+                                            " slack " + std::to_string(slack) + ": " + why);
+                }
+              }
+              for (Tally* t : {&by_family[family][pl.name], &by_slack[pl.name][slack]}) {
+                ++t->total;
+                t->ms.push_back(ms);
+                if (ok) {
+                  ++t->solved;
+                  t->cusps += static_cast<int>(r.path.partial_paths.size()) - 1;
+                }
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  double load[3] = {0, 0, 0};
+  if (::getloadavg(load, 3) != 3) load[0] = -1;
+  std::printf("load average %.2f %.2f %.2f\n\n", load[0], load[1], load[2]);
+  std::printf(
+      "| family | planner | solved | mean direction changes | p50 [ms] | p95 [ms] |\n|---|---|---|---|---|---|\n");
+  for (auto& [family, rows] : by_family) {
+    for (const Planner& pl : planners) {
+      Tally& t = rows[pl.name];
+      const auto s = pullout::bench::summarize(t.ms);
+      std::printf("| %s | %s | %d/%d | %.2f | %.2f | %.2f |\n", family.c_str(), pl.name, t.solved, t.total,
+                  t.solved ? static_cast<double>(t.cusps) / t.solved : 0.0, s.p50, s.p95);
+    }
+  }
+  std::printf("\n| planner | slack [m] | solved | p50 [ms] | p95 [ms] |\n|---|---|---|---|---|\n");
+  for (const Planner& pl : planners) {
+    for (auto& [slack, t] : by_slack[pl.name]) {
+      const auto s = pullout::bench::summarize(t.ms);
+      std::printf("| %s | %.1f | %d/%d | %.2f | %.2f |\n", pl.name, slack, t.solved, t.total, s.p50, s.p95);
+    }
+  }
+  std::printf("\noracle failures: %zu\n", oracle_failures.size());
+  for (const auto& f : oracle_failures) std::printf("  %s\n", f.c_str());
+  return 0;
+}
