@@ -47,7 +47,8 @@ bool cover(const GridCollisionChecker& checker, double growth, const Arc& arc, d
     const bool last = covered + 2.0 * half_stretch >= to;  // this test's stretch reaches `to`
     const double s = last ? std::max(from, to - half_stretch) : covered + half_stretch;
     double clearance = 0.0;
-    if (checker.collides(arc.at(sign * s, c, sn), c, sn, clearance)) return false;
+    const Pose2 pose = arc.at(sign * s, c, sn);  // (before the call: it sets c and sn)
+    if (checker.collides(pose, c, sn, clearance)) return false;
     if (last) break;  // (not left to the loop condition: rounding could repeat the same test)
     covered = s + half_stretch + clearance / factor;
   }
@@ -76,7 +77,8 @@ bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_cleara
     const double s = last ? std::max(0.0, total - half_stretch) : covered + half_stretch;
     const double stretch_end = std::min(total, s + half_stretch);
     double clearance = 0.0;
-    if (checkers.swept.collides(arc.at(sign * s, c, sn), c, sn, clearance)) {
+    const Pose2 pose = arc.at(sign * s, c, sn);  // (before the call: it sets c and sn)
+    if (checkers.swept.collides(pose, c, sn, clearance)) {
       // Refused by the coarse growth: the same stretch in finer tests decides.
       if (!cover(checkers.fine, checkers.fine_growth, arc, sign, factor, covered, stretch_end)) return false;
       clearance = 0.0;
