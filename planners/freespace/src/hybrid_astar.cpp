@@ -214,8 +214,9 @@ class Search {
       Pose2 pose;
       double clearance;
     };
-    std::array<Move, 2 * (2 * kMaxTurningSteps + 1)> moves;
-    std::array<Move, 2 * (2 * kMaxTurningSteps + 1)> refused;
+    constexpr std::size_t kMaxMoves = 2 * (2 * static_cast<std::size_t>(kMaxTurningSteps) + 1);
+    std::array<Move, kMaxMoves> moves;
+    std::array<Move, kMaxMoves> refused;
     std::size_t free_count = 0;
     std::size_t refused_count = 0;
     int open = 0;
