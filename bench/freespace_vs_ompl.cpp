@@ -6,6 +6,7 @@
 //                               [--ours-only]
 //
 //   build/bench/bench_freespace --tpcap ../shared/benchmarks/tpcap [--resolution 0.1] [--budget-ms 10000]
+//                               [--case N] [--min-primitive M] [--search-from-goal]
 //
 // --tpcap runs the 20 TPCAP cases (bench/tpcap.hpp; read at run time, never committed) instead of
 // the generated lots: the organisers' vehicle (no shape margin), turning radius from wheelbase
@@ -167,6 +168,8 @@ struct SearchOverrides {
   double xy_resolution{0.0};
   double narrow_penalty{-1.0};  // < 0: the default
   int turning_steps{0};
+  double min_primitive{-1.0};  // < 0: the default
+  bool from_goal{false};
 } g_search;
 
 struct Run {
@@ -176,6 +179,7 @@ struct Run {
   int direction_changes{0};
   std::size_t expansions{0};
   int status{0};  // ours: HybridAStarResult::Status
+  bool from_goal{false};
 };
 
 Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
@@ -185,6 +189,8 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   config.xy_resolution = g_search.xy_resolution;
   if (g_search.turning_steps > 0) config.turning_steps = g_search.turning_steps;
   if (g_search.narrow_penalty >= 0.0) config.narrow_heuristic_penalty = g_search.narrow_penalty;
+  if (g_search.min_primitive >= 0.0) config.min_primitive_length = g_search.min_primitive;
+  if (g_search.from_goal) config.search_from_goal = true;
   std::vector<Pose2> expanded;
   const char* dump = std::getenv("PULLOUT_DUMP_EXPANSIONS");  // directory: <problem index>.pgm / .txt
   if (dump != nullptr) config.expanded_poses = &expanded;
@@ -198,6 +204,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   run.success = r.status == pullout::HybridAStarResult::Status::kSuccess;
   run.length = r.length;
   run.expansions = r.expansions;
+  run.from_goal = r.found_from_goal;
   run.status = static_cast<int>(r.status);
   if (dump != nullptr) {
     // A picture of the search: the costmap as a PGM (north up) and the expanded poses as text.
@@ -335,12 +342,19 @@ int main(int argc, char** argv) {
   bool ours_only = false;         // --ours-only: skip OMPL, print search statistics
   std::string tpcap;              // --tpcap DIR: the TPCAP cases instead of generated lots
   double tpcap_resolution = 0.1;  // [m]
+  int only_case = 0;              // --case N: this TPCAP case only (1-based)
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(argv[i], "--ours-only") == 0) {
       ours_only = true;
     } else if (has_value && std::strcmp(argv[i], "--tpcap") == 0) {
       tpcap = argv[++i];
+    } else if (std::strcmp(argv[i], "--search-from-goal") == 0) {
+      g_search.from_goal = true;
+    } else if (has_value && std::strcmp(argv[i], "--min-primitive") == 0) {
+      g_search.min_primitive = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--case") == 0) {
+      only_case = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--resolution") == 0) {
       tpcap_resolution = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--problems") == 0) {
@@ -382,6 +396,7 @@ int main(int argc, char** argv) {
   std::printf("%-18s %28s %28s %28s\n", "problem", names[0], names[1], names[2]);
   for (int i = 0; i < problems; ++i) {
     Problem p;
+    if (!tpcap.empty() && only_case > 0 && i + 1 != only_case) continue;
     if (tpcap.empty()) {
       p = make_problem(i, rng, fp);
     } else if (!make_tpcap(tpcap, i + 1, tpcap_resolution, p)) {
@@ -400,8 +415,9 @@ int main(int argc, char** argv) {
     if (ours_only) {
       const Run r = run_ours(p, checker, radius, budget_ms, heuristic_weight);
       runs[0].push_back(r);
-      std::printf("%-18s %8.1f ms %6.1f m %2d cusps %8zu expansions%s\n", p.name.c_str(), r.time_ms, r.length,
-                  r.direction_changes, r.expansions, r.success ? "" : "  (no solution)");
+      std::printf("%-18s %8.1f ms %6.1f m %2d cusps %8zu expansions%s%s\n", p.name.c_str(), r.time_ms, r.length,
+                  r.direction_changes, r.expansions, r.success ? "" : "  (no solution)",
+                  r.from_goal ? "  (from the goal)" : "");
       if (!r.success) std::printf("%-18s   status %d (HybridAStarResult::Status)\n", "", r.status);
       if (p.size == 30.0 && p.resolution > 0.15 && r.success) small_ours.push_back(r.time_ms);
       continue;

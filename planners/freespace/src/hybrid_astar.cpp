@@ -1,7 +1,9 @@
 #include "pullout/freespace/hybrid_astar.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
 #include <queue>
 
 #include "pullout/freespace/reeds_shepp.hpp"
@@ -19,17 +21,20 @@ constexpr int kShotCandidates = 3;                // Reeds-Shepp words tried per
 constexpr double kShotDistancePerInterval = 4.0;  // [m] heuristic distance per expansion between shots
 constexpr double kReedsSheppRange = 4.0;          // [turning radii] see heuristic()
 constexpr double kCoarseSpacing = 1.0;            // [m] first-pass sample spacing of a shot
-constexpr double kSweepGrowth = 0.5;              // [cells] footprint growth between tested poses
-constexpr double kFineSweepGrowth = 0.125;        // [cells] the same where kSweepGrowth refuses
+constexpr std::uint64_t kFineKey = 1ULL << 62;    // lattice keys of fine cells
+// A node with fewer full-length primitives to new cells than this is constrained (see expand).
+constexpr int kOpenPrimitives = 3;
 
 struct Node {
   Pose2 pose;
   double g{0.0};
   std::int32_t parent{-1};
   float clearance{0.0F};     // [m] clearance lower bound of the footprint at `pose` (0: near)
+  double length{0.0};        // [m] arc length of the primitive that led here (cut short at a contact)
   std::int8_t steer{0};      // steer index of the primitive that led here
   std::int8_t direction{0};  // +1 / -1 of that primitive, 0 at the start
   bool closed{false};
+  bool fine{false};  // its lattice cell is a fine one (see key())
 };
 
 // How the last piece (goal region or shot) was reached.
@@ -39,93 +44,84 @@ struct Finish {
   ReedsSheppPath path;
 };
 
+// One direction of the search. From the start (forward), it ends in the goal region or with a
+// Reeds-Shepp shot to the goal. From the goal (backward), it grows the path backwards in time:
+// a primitive it drives forwards is one the vehicle drives in reverse (and is charged so), and it
+// ends only with a shot to the exact start (a path must begin where the vehicle is).
 class Search {
  public:
-  Search(const GridCollisionChecker& checker, const HybridAStarConfig& config, const Pose2& start, const Pose2& goal)
+  enum class State { kRunning, kFound, kExhausted, kNodeLimit, kStopped };
+
+  Search(const GridCollisionChecker& checker, const HybridAStarConfig& config, const Pose2& root, const Pose2& target,
+         bool backward)
       : checker_(checker),
         costmap_(checker.costmap()),
         config_(config),
-        start_(start),
-        goal_(goal),
+        root_(root),
+        target_(target),
+        backward_(backward),
         rs_(config.turning_radius),
         weights_{config.curve_weight, config.reverse_weight, config.direction_change_weight},
-        heuristic_(costmap_, heuristic_config(checker, config), goal),
-        swept_checker_(costmap_, grown(checker.footprint(), kSweepGrowth * costmap_.resolution())),
-        fine_checker_(costmap_, grown(checker.footprint(), kFineSweepGrowth * costmap_.resolution())),
-        sweep_{checker_, swept_checker_, kSweepGrowth * costmap_.resolution(), fine_checker_,
-               kFineSweepGrowth * costmap_.resolution()} {}
+        heuristic_(costmap_, heuristic_config(checker, config), target) {}
 
-  HybridAStarResult run(const StopCondition& stop) {
-    HybridAStarResult result;
+  // Puts the root (known free, with clearance bound `clearance`) on the open list.
+  void begin(const StopCondition& stop, double clearance) {
     heuristic_.watch(stop);
-    double start_clearance = 0.0;
-    if (checker_.collides(start_, start_clearance)) {
-      result.status = HybridAStarResult::Status::kStartOccupied;
-      return result;
-    }
-    if (checker_.collides(goal_)) {
-      result.status = HybridAStarResult::Status::kGoalOccupied;
-      return result;
-    }
-    Node start_node;
-    start_node.pose = start_;
-    start_node.clearance = static_cast<float>(start_clearance);
-    add_node(start_node);
-    Finish finish;
-    std::size_t since_shot = 0;
-    bool node_limit = false;
+    Node root;
+    root.pose = root_;
+    root.clearance = static_cast<float>(clearance);
+    add_node(root);
+  }
+
+  // One expansion (or none, when only superseded entries were popped).
+  State step() {
+    if (heuristic_.stopped() != StopReason::kNone) return State::kStopped;  // it stopped inside a flood
     while (!open_.empty()) {
-      if (result.expansions % kStopCheckInterval == 0) {
-        result.stopped = stop.check();
-        if (result.stopped != StopReason::kNone) break;
-      }
-      if (heuristic_.stopped() != StopReason::kNone) {  // it stopped inside a flood of the grid
-        result.stopped = heuristic_.stopped();
-        break;
-      }
-      const auto [f, index] = open_.top();
+      const std::int32_t index = open_.top().second;
       open_.pop();
-      if (nodes_[static_cast<std::size_t>(index)].closed) continue;
-      nodes_[static_cast<std::size_t>(index)].closed = true;
-      ++result.expansions;
-      const Node node = nodes_[static_cast<std::size_t>(index)];
+      Node& top = nodes_[static_cast<std::size_t>(index)];
+      if (top.closed) continue;
+      top.closed = true;
+      ++expansions_;
+      const Node node = top;
       if (config_.expanded_poses != nullptr) config_.expanded_poses->push_back(node.pose);
-      if (in_goal_region(node.pose)) {
-        finish.node = index;
-        break;
+      if (!backward_ && in_goal_region(node.pose)) {
+        finish_.node = index;
+        return State::kFound;
       }
-      // Analytic expansion: every expansion near the goal, less often far from it.
+      // Analytic expansion: every expansion near the target, less often far from it.
       const double h2d = heuristic_.distance(node.pose);
       const auto interval = static_cast<std::size_t>(std::max(1.0, h2d / kShotDistancePerInterval));
-      if (++since_shot >= interval) {
-        since_shot = 0;
-        ++result.shots;
-        if (shoot(node, finish.path)) {
-          finish.node = index;
-          finish.shot = true;
-          break;
+      if (++since_shot_ >= interval) {
+        since_shot_ = 0;
+        ++shots_;
+        if (shoot(node, finish_.path)) {
+          finish_.node = index;
+          finish_.shot = true;
+          return State::kFound;
         }
       }
-      if (nodes_.size() >= config_.max_nodes) {
-        node_limit = true;
-        break;
-      }
+      if (nodes_.size() >= config_.max_nodes) return State::kNodeLimit;
       expand(index);
+      return heuristic_.stopped() != StopReason::kNone ? State::kStopped : State::kRunning;
     }
-    result.nodes = nodes_.size();
-    // A heuristic stopped inside a flood answers nothing useful: what followed is no verdict.
-    if (result.stopped == StopReason::kNone && finish.node < 0) result.stopped = heuristic_.stopped();
-    if (finish.node < 0) {
-      result.status = result.stopped == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
-                      : result.stopped != StopReason::kNone    ? HybridAStarResult::Status::kTimeout
-                      : node_limit                             ? HybridAStarResult::Status::kNodeLimit
-                                                               : HybridAStarResult::Status::kNoPath;
-      return result;
-    }
-    result.status = HybridAStarResult::Status::kSuccess;
-    result.reached_exact_goal = finish.shot;
-    build_waypoints(finish, result);
-    return result;
+    return State::kExhausted;
+  }
+
+  // Whether the root is in a tight spot (fewer than kOpenPrimitives primitives lead out of its
+  // cell): known after the first step.
+  bool root_constrained() const { return root_constrained_; }
+  std::size_t expansions() const { return expansions_; }
+  std::size_t nodes() const { return nodes_.size(); }
+  std::size_t shots() const { return shots_; }
+  StopReason heuristic_stopped() const { return heuristic_.stopped(); }
+
+  // The path of a search that found one, from the start to the goal (or the pose in the goal
+  // region) in the vehicle's direction of travel.
+  void result(HybridAStarResult& out) const {
+    out.reached_exact_goal = backward_ || finish_.shot;
+    build_waypoints(out);
+    out.found_from_goal = backward_;
   }
 
  private:
@@ -146,14 +142,18 @@ class Search {
     return h;
   }
 
-  std::uint64_t key(const Pose2& p) const {
-    const Vec2 g = costmap_.to_grid({p.x, p.y}) * (costmap_.resolution() / xy_resolution());
-    const auto ix = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(g.x())) + (1 << 20));
-    const auto iy = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(g.y())) + (1 << 20));
-    const double bin = kTwoPi / config_.theta_size;
+  // The lattice cell of a pose: coarse, or (children of a constrained node, see expand) fine in
+  // position and heading, where poses a few centimetres apart differ in what they can reach.
+  std::uint64_t key(const Pose2& p, bool fine) const {
+    const double cell = fine ? config_.fine_xy_resolution : xy_resolution();
+    const int bins = fine ? config_.theta_size * config_.fine_theta_factor : config_.theta_size;
+    const Vec2 g = costmap_.to_grid({p.x, p.y}) * (costmap_.resolution() / cell);
+    const auto ix = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(g.x())) + (1 << 19));
+    const auto iy = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(g.y())) + (1 << 19));
+    const double bin = kTwoPi / bins;
     auto it = static_cast<std::int64_t>(std::floor((normalize_angle(p.yaw) + kPi) / bin));
-    it = ((it % config_.theta_size) + config_.theta_size) % config_.theta_size;
-    return (ix << 42) | (iy << 20) | static_cast<std::uint64_t>(it);
+    it = ((it % bins) + bins) % bins;
+    return (fine ? kFineKey : 0) | (ix << 41) | (iy << 20) | static_cast<std::uint64_t>(it);
   }
 
   // Plain Reeds-Shepp length: the cost weights make the true cost larger still, but a weighted
@@ -166,24 +166,24 @@ class Search {
     const double h2d = heuristic_.distance(p);
     if (!std::isfinite(h2d)) return h2d;
     if (h2d > kReedsSheppRange * config_.turning_radius) return config_.distance_heuristic_weight * h2d;
-    return config_.distance_heuristic_weight * std::max(h2d, rs_.distance(p, goal_));
+    return config_.distance_heuristic_weight * std::max(h2d, rs_.distance(p, target_));
   }
 
   bool in_goal_region(const Pose2& p) const {
-    const double c = std::cos(goal_.yaw);
-    const double s = std::sin(goal_.yaw);
-    const double dx = p.x - goal_.x;
-    const double dy = p.y - goal_.y;
+    const double c = std::cos(target_.yaw);
+    const double s = std::sin(target_.yaw);
+    const double dx = p.x - target_.x;
+    const double dy = p.y - target_.y;
     const double lon = c * dx + s * dy;
     const double lat = -s * dx + c * dy;
     return std::abs(lon) <= 0.5 * config_.longitudinal_goal_range &&
            std::abs(lat) <= 0.5 * config_.lateral_goal_range &&
-           std::abs(normalize_angle(p.yaw - goal_.yaw)) <= 0.5 * config_.angle_goal_range;
+           std::abs(normalize_angle(p.yaw - target_.yaw)) <= 0.5 * config_.angle_goal_range;
   }
 
   // Adds a node unless its lattice cell holds a cheaper one; pushes it on the open list.
   void add_node(const Node& node) {
-    std::int32_t* slot = table_.find_or_insert(key(node.pose));
+    std::int32_t* slot = table_.find_or_insert(key(node.pose, node.fine));
     if (*slot >= 0) {
       Node& existing = nodes_[static_cast<std::size_t>(*slot)];
       if (existing.closed || existing.g <= node.g) return;
@@ -196,40 +196,88 @@ class Search {
     open_.push({node.g + h, *slot});
   }
 
+  // A node's children: the full-length primitives that are free. A node with fewer than
+  // kOpenPrimitives of them reaching a new cell is constrained (a tight spot: a bay's end, a
+  // parallel slot, a pocket of a maze): it also drives the refused primitives until contact when
+  // that is at least min_primitive_length, and its children get fine lattice cells, so that the
+  // short moves between cusps with which a car wriggles out of such a spot are not merged away.
+  // Elsewhere the search is the plain one.
   void expand(std::int32_t index) {
     const Node parent = nodes_[static_cast<std::size_t>(index)];
-    const std::uint64_t parent_key = key(parent.pose);
     const int steps = config_.turning_steps;
-    const double length = config_.primitive_length;
     const double c = std::cos(parent.pose.yaw);
     const double s = std::sin(parent.pose.yaw);
+    struct Move {
+      int direction;
+      int steer;
+      double distance;  // [m] signed
+      Pose2 pose;
+      double clearance;
+    };
+    constexpr std::size_t kMaxMoves = 2 * (2 * static_cast<std::size_t>(kMaxTurningSteps) + 1);
+    std::array<Move, kMaxMoves> moves;
+    std::array<Move, kMaxMoves> refused;
+    std::size_t free_count = 0;
+    std::size_t refused_count = 0;
+    int open = 0;
+    const std::uint64_t coarse_parent = key(parent.pose, false);
     for (const int direction : {1, -1}) {
       if (direction < 0 && !config_.use_back) continue;
       for (int steer = -steps; steer <= steps; ++steer) {
-        const fd::Arc arc(parent.pose, c, s, static_cast<double>(steer) / steps / config_.turning_radius);
-        const double distance = direction * length;
-        const Pose2 child_pose = arc.at(distance);
-        if (key(child_pose) == parent_key) continue;
+        const fd::Arc arc(parent.pose, c, s, curvature(steer));
+        const double distance = direction * config_.primitive_length;
         double clearance = 0.0;
-        if (!fd::arc_free(sweep_, arc, parent.clearance, distance, clearance)) continue;
-        double cost = length * (1.0 + config_.curve_weight * std::abs(steer) / steps);
-        if (direction < 0) cost *= 1.0 + config_.reverse_weight;
-        if (parent.direction != 0 && parent.direction != direction) cost += config_.direction_change_weight;
-        Node child;
-        child.pose = child_pose;
-        child.g = parent.g + cost;
-        child.parent = index;
-        child.clearance = static_cast<float>(clearance);
-        child.steer = static_cast<std::int8_t>(steer);
-        child.direction = static_cast<std::int8_t>(direction);
-        add_node(child);
+        if (!fd::arc_free(checker_, arc, parent.clearance, distance, clearance)) {
+          refused[refused_count++] = {direction, steer, distance, {}, 0.0};
+          continue;
+        }
+        const Pose2 pose = arc.at(distance);
+        open += key(pose, false) != coarse_parent ? 1 : 0;
+        moves[free_count++] = {direction, steer, distance, pose, clearance};
       }
     }
+    const bool constrained = config_.min_primitive_length > 0.0 && open < kOpenPrimitives;
+    if (parent.parent < 0) root_constrained_ = constrained;
+    if (constrained && config_.min_primitive_length > 0.0) {
+      for (std::size_t i = 0; i < refused_count; ++i) {
+        Move m = refused[i];
+        const fd::Arc arc(parent.pose, c, s, curvature(m.steer));
+        const double free = fd::free_prefix(checker_, arc, parent.clearance, m.distance, config_.min_primitive_length);
+        if (free < config_.min_primitive_length) continue;
+        m.distance = m.direction * free;
+        m.pose = arc.at(m.distance);
+        if (checker_.collides(m.pose, m.clearance)) continue;  // (free_prefix tested it: rounding only)
+        moves[free_count++] = m;
+      }
+    }
+    const std::uint64_t parent_key = key(parent.pose, parent.fine);
+    for (std::size_t i = 0; i < free_count; ++i) {
+      const Move& m = moves[i];
+      if (key(m.pose, constrained) == parent_key) continue;
+      const double driven = std::abs(m.distance);
+      double cost = driven * (1.0 + config_.curve_weight * std::abs(m.steer) / steps);
+      if ((m.direction < 0) != backward_) cost *= 1.0 + config_.reverse_weight;  // the vehicle reverses
+      if (parent.direction != 0 && parent.direction != m.direction) cost += config_.direction_change_weight;
+      Node child;
+      child.pose = m.pose;
+      child.g = parent.g + cost;
+      child.parent = index;
+      child.clearance = static_cast<float>(m.clearance);
+      child.length = driven;
+      child.steer = static_cast<std::int8_t>(m.steer);
+      child.direction = static_cast<std::int8_t>(m.direction);
+      child.fine = constrained;
+      add_node(child);
+    }
+  }
+
+  double curvature(int steer) const {
+    return static_cast<double>(steer) / config_.turning_steps / config_.turning_radius;
   }
 
   bool shoot(const Node& node, ReedsSheppPath& out) const {
     if (!config_.use_back) return false;  // Reeds-Shepp words reverse; a forward-only search never shoots
-    std::vector<ReedsSheppPath> words = rs_.all(node.pose, goal_);
+    std::vector<ReedsSheppPath> words = rs_.all(node.pose, target_);
     std::vector<std::pair<double, std::size_t>> order;
     order.reserve(words.size());
     for (std::size_t i = 0; i < words.size(); ++i)
@@ -254,7 +302,7 @@ class Search {
         const ReedsSheppSegment& seg = p.segments[static_cast<std::size_t>(i)];
         if (std::abs(seg.length) < 1e-9) continue;
         const double k = static_cast<double>(static_cast<int>(seg.kind)) / config_.turning_radius;
-        const bool free = fine ? fd::arc_free(sweep_, fd::Arc(pose, k), clearance, seg.length, clearance)
+        const bool free = fine ? fd::arc_free(checker_, fd::Arc(pose, k), clearance, seg.length, clearance)
                                : fd::arc_samples_free(checker_, pose, k, seg.length, kCoarseSpacing);
         if (!free) return false;
         pose = fd::drive(pose, k, seg.length);
@@ -271,56 +319,64 @@ class Search {
     for (int i = 1; i <= n; ++i) out.push_back({fd::drive(from, curvature, distance * i / n), dir});
   }
 
-  void build_waypoints(const Finish& finish, HybridAStarResult& result) const {
+  // The waypoints from the root along the search's own direction of travel; the search from the
+  // goal then turns them around (the same poses, in the opposite order and direction).
+  void build_waypoints(HybridAStarResult& result) const {
     std::vector<std::int32_t> chain;
-    for (std::int32_t i = finish.node; i >= 0; i = nodes_[static_cast<std::size_t>(i)].parent) chain.push_back(i);
+    for (std::int32_t i = finish_.node; i >= 0; i = nodes_[static_cast<std::size_t>(i)].parent) chain.push_back(i);
     std::reverse(chain.begin(), chain.end());
-    std::vector<Waypoint>& w = result.waypoints;
-    w.push_back({start_, 1});
+    std::vector<Waypoint> w;
+    w.push_back({root_, 1});
     for (std::size_t c = 1; c < chain.size(); ++c) {
       const Node& n = nodes_[static_cast<std::size_t>(chain[c])];
       const Node& parent = nodes_[static_cast<std::size_t>(n.parent)];
-      const double k = static_cast<double>(n.steer) / config_.turning_steps / config_.turning_radius;
-      append_arc(parent.pose, k, n.direction * config_.primitive_length, w);
-      result.length += config_.primitive_length;
+      append_arc(parent.pose, curvature(n.steer), n.direction * n.length, w);
+      result.length += n.length;
     }
-    if (finish.shot) {
-      Pose2 pose = nodes_[static_cast<std::size_t>(finish.node)].pose;
-      for (int i = 0; i < finish.path.count; ++i) {
-        const ReedsSheppSegment& seg = finish.path.segments[static_cast<std::size_t>(i)];
+    if (finish_.shot) {
+      Pose2 pose = nodes_[static_cast<std::size_t>(finish_.node)].pose;
+      for (int i = 0; i < finish_.path.count; ++i) {
+        const ReedsSheppSegment& seg = finish_.path.segments[static_cast<std::size_t>(i)];
         if (std::abs(seg.length) < 1e-9) continue;
         const double k = static_cast<double>(static_cast<int>(seg.kind)) / config_.turning_radius;
         append_arc(pose, k, seg.length, w);
         pose = fd::drive(pose, k, seg.length);
       }
-      result.length += finish.path.length;
-      w.back().pose = goal_;  // removes the rounding of the integration
+      result.length += finish_.path.length;
+      w.back().pose = target_;  // removes the rounding of the integration
     }
-    if (w.size() >= 2) w.front().direction = w[1].direction;
-    if (w.size() == 1) w.push_back(w.front());  // start already in the goal region: a zero-length path
-  }
-
-  static Footprint grown(Footprint f, double by) {
-    f.front += by;
-    f.rear += by;
-    f.left += by;
-    f.right += by;
-    return f;
+    if (w.size() == 1) w.push_back(w.front());  // the root already in the goal region: a zero-length path
+    if (backward_) {
+      // Waypoint i's direction is that of the motion from i - 1 to i: reversed, the motion from
+      // w[n - i + 1] to w[n - i] is the search's motion into w[n - i + 1], driven the other way.
+      std::vector<Waypoint> turned(w.size());
+      const std::size_t n = w.size() - 1;
+      for (std::size_t i = 0; i <= n; ++i) {
+        turned[i].pose = w[n - i].pose;
+        turned[i].direction = i == 0 ? 1 : -w[n - i + 1].direction;
+      }
+      w.swap(turned);
+    }
+    w.front().direction = w[1].direction;
+    result.waypoints = std::move(w);
   }
 
   const GridCollisionChecker& checker_;
   const Costmap& costmap_;
   const HybridAStarConfig& config_;
-  Pose2 start_;
-  Pose2 goal_;
+  Pose2 root_;
+  Pose2 target_;
+  bool backward_{false};
   ReedsShepp rs_;
   ReedsSheppWeights weights_;
   mutable fd::ObstacleHeuristic heuristic_;  // computed lazily, as the search asks
-  GridCollisionChecker swept_checker_;       // the footprint grown for the motion between tested poses
-  GridCollisionChecker fine_checker_;        // grown less, where swept_checker_ refuses
-  fd::SweepCheckers sweep_;
   std::vector<Node> nodes_;
   fd::NodeTable table_;
+  Finish finish_;
+  std::size_t since_shot_{0};
+  std::size_t expansions_{0};
+  std::size_t shots_{0};
+  bool root_constrained_{false};
   using OpenItem = std::pair<double, std::int32_t>;
   std::priority_queue<OpenItem, std::vector<OpenItem>, std::greater<OpenItem>> open_;
 };
@@ -348,19 +404,80 @@ const char* to_string(HybridAStarResult::Status status) {
 }
 
 HybridAStar::HybridAStar(const GridCollisionChecker& checker, const HybridAStarConfig& config)
-    : checker_(checker), config_(config) {}
+    : checker_(checker), config_(config) {
+  config_.turning_steps = std::clamp(config_.turning_steps, 1, kMaxTurningSteps);
+}
 
 HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const StopCondition& stop) const {
+  HybridAStarResult result;
   // Stopped before it starts: no heuristic grid either (the costliest part of the set-up).
   if (const StopReason reason = stop.check(); reason != StopReason::kNone) {
-    HybridAStarResult result;
     result.stopped = reason;
     result.status =
         reason == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled : HybridAStarResult::Status::kTimeout;
     return result;
   }
-  Search search(checker_, config_, start, goal);
-  return search.run(stop);
+  double start_clearance = 0.0;
+  if (checker_.collides(start, start_clearance)) {
+    result.status = HybridAStarResult::Status::kStartOccupied;
+    return result;
+  }
+  double goal_clearance = 0.0;
+  if (checker_.collides(goal, goal_clearance)) {
+    result.status = HybridAStarResult::Status::kGoalOccupied;
+    return result;
+  }
+  // The search from the start, and, when the goal lies in a tight spot (its first expansion finds
+  // it constrained), the search from the goal too, taking turns: getting out of a tight spot is
+  // found where a search begins, where every short move is tried; getting into one from far away
+  // means hitting a small target (bench/RESULTS.md: TPCAP case 7, parallel parking).
+  Search forward(checker_, config_, start, goal, false);
+  std::unique_ptr<Search> backward;
+  forward.begin(stop, start_clearance);
+  if (config_.use_back && config_.search_from_goal) {
+    backward = std::make_unique<Search>(checker_, config_, goal, start, true);
+    backward->begin(stop, goal_clearance);
+  }
+  Search::State state = Search::State::kRunning;
+  Search* found = nullptr;
+  bool forward_done = false;
+  bool backward_done = backward == nullptr;
+  bool node_limit = false;
+  for (std::size_t turn = 0; !forward_done || !backward_done; ++turn) {
+    if (turn % kStopCheckInterval == 0 && (result.stopped = stop.check()) != StopReason::kNone) break;
+    const bool backward_turn = !backward_done && (forward_done || turn % 2 == 1);
+    Search& search = backward_turn ? *backward : forward;
+    state = search.step();
+    if (state == Search::State::kFound) {
+      found = &search;
+      break;
+    }
+    if (state == Search::State::kStopped) {
+      result.stopped = search.heuristic_stopped();
+      break;
+    }
+    if (state != Search::State::kRunning) {
+      node_limit = node_limit || state == Search::State::kNodeLimit;
+      (backward_turn ? backward_done : forward_done) = true;
+    }
+    // The goal is open: the search from the start alone (its root expanded by now).
+    if (backward_turn && backward != nullptr && backward->expansions() == 1 && !backward->root_constrained()) {
+      backward_done = true;
+    }
+  }
+  result.expansions = forward.expansions() + (backward != nullptr ? backward->expansions() : 0);
+  result.nodes = forward.nodes() + (backward != nullptr ? backward->nodes() : 0);
+  result.shots = forward.shots() + (backward != nullptr ? backward->shots() : 0);
+  if (found == nullptr) {
+    result.status = result.stopped == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
+                    : result.stopped != StopReason::kNone    ? HybridAStarResult::Status::kTimeout
+                    : node_limit                             ? HybridAStarResult::Status::kNodeLimit
+                                                             : HybridAStarResult::Status::kNoPath;
+    return result;
+  }
+  result.status = HybridAStarResult::Status::kSuccess;
+  found->result(result);
+  return result;
 }
 
 }  // namespace pullout

@@ -34,57 +34,79 @@ Pose2 Arc::at(double distance, double& cos_yaw, double& sin_yaw) const {
 
 namespace {
 
-// Covers [from, to] of the arc with tests of `checker` (the footprint grown by `growth`): true when
-// all pass. The tests sit at most half a stretch inside the interval's ends (a test's grown
-// footprint reaches half a stretch of motion both ways, and no farther).
-bool cover(const GridCollisionChecker& checker, double growth, const Arc& arc, double sign, double factor, double from,
-           double to) {
-  const double half_stretch = growth / factor;
-  double covered = from;
-  double c = 1.0;
-  double sn = 0.0;
-  while (covered < to) {
-    const bool last = covered + 2.0 * half_stretch >= to;  // this test's stretch reaches `to`
-    const double s = last ? std::max(from, to - half_stretch) : covered + half_stretch;
-    double clearance = 0.0;
-    if (checker.collides(arc.at(sign * s, c, sn), c, sn, clearance)) return false;
-    if (last) break;  // (not left to the loop condition: rounding could repeat the same test)
-    covered = s + half_stretch + clearance / factor;
+// [rad] heading change covered by one hull test: the hulls then lie within ~1 cm of the sweep
+constexpr double kMaxSweepTurn = 0.06;
+constexpr double kSweepSafety = 1e-6;  // [m] added to the sagitta: rounding only
+
+// True when the motion over [from, to] (0 <= from <= to, metres along the arc in the direction
+// `sign`) is free: hull tests of consecutive poses at most kMaxSweepTurn apart in heading, each
+// grown by the sagitta of that turn (GridCollisionChecker::sweep_collides).
+bool sweep_free(const GridCollisionChecker& checker, const Arc& arc, double sign, double from, double to) {
+  const double turn = std::abs(arc.curvature()) * (to - from);
+  const int pieces = std::max(1, static_cast<int>(std::ceil(turn / kMaxSweepTurn)));
+  const double margin = checker.sweep_margin(arc.curvature(), turn / pieces) + kSweepSafety;
+  Pose2 previous = arc.at(sign * from);
+  for (int i = 1; i <= pieces; ++i) {
+    const Pose2 next = arc.at(sign * (from + (to - from) * i / pieces));
+    if (checker.sweep_collides(previous, next, margin)) return false;
+    previous = next;
   }
   return true;
 }
 
 }  // namespace
 
-bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_clearance, double distance,
+bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
               double& end_clearance) {
   const double total = std::abs(distance);
   const double sign = distance < 0.0 ? -1.0 : 1.0;
-  const double factor = checkers.exact.sweep_factor(arc.curvature());
+  const double factor = checker.sweep_factor(arc.curvature());
   double c = 1.0;
   double sn = 0.0;
   // The end first: where the search stops, tested exactly (and the likeliest to collide).
   const Pose2 end = arc.at(distance, c, sn);
-  if (checkers.exact.collides(end, c, sn, end_clearance)) return false;
-  double covered = start_clearance / factor;                    // [0, covered] is known free
+  if (checker.collides(end, c, sn, end_clearance)) return false;
+  const double covered = start_clearance / factor;              // [0, covered] is known free
   const double uncovered_end = total - end_clearance / factor;  // so is [uncovered_end, total]
-  const double half_stretch = checkers.growth / factor;
-  while (covered < uncovered_end) {
-    // The last test sits half a stretch before the end (not on it: the grown footprint there would
-    // reach past the end pose, towards what it may be close to).
-    const bool last = covered + 2.0 * half_stretch >= total;
-    const double s = last ? std::max(0.0, total - half_stretch) : covered + half_stretch;
-    const double stretch_end = std::min(total, s + half_stretch);
-    double clearance = 0.0;
-    if (checkers.swept.collides(arc.at(sign * s, c, sn), c, sn, clearance)) {
-      // Refused by the coarse growth: the same stretch in finer tests decides.
-      if (!cover(checkers.fine, checkers.fine_growth, arc, sign, factor, covered, stretch_end)) return false;
-      clearance = 0.0;
-    }
-    if (last) break;  // (not left to the loop condition: rounding could repeat the same test)
-    covered = stretch_end + clearance / factor;
+  if (covered >= uncovered_end) return true;
+  return sweep_free(checker, arc, sign, std::max(0.0, covered), std::min(total, uncovered_end));
+}
+
+double free_prefix(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+                   double min_length) {
+  const double total = std::abs(distance);
+  const double sign = distance < 0.0 ? -1.0 : 1.0;
+  const double factor = checker.sweep_factor(arc.curvature());
+  // Exact samples a cell apart (of the footprint's fastest point) up to the first collision: the
+  // motion gets no farther than the last free one. Cheap where it matters: a pose at contact
+  // fails its first samples.
+  const double step = checker.costmap().resolution() / factor;
+  double c = 1.0;
+  double sn = 0.0;
+  double last_free = 0.0;  // the start is free
+  double s = std::max(min_length, start_clearance / factor);
+  double clearance = 0.0;
+  while (true) {
+    const double at = std::min(s, total);
+    const Pose2 pose = arc.at(sign * at, c, sn);  // (before the call: it sets c and sn)
+    if (checker.collides(pose, c, sn, clearance)) break;
+    last_free = at;
+    if (at >= total) break;
+    s = at + step + clearance / factor;
   }
-  return true;
+  if (last_free < min_length) return 0.0;
+  double end_clearance = 0.0;
+  if (arc_free(checker, arc, start_clearance, sign * last_free, end_clearance)) return last_free;
+  // The sweep to it touches: bisection for the longest free prefix (free at lo, not at hi).
+  double lo = min_length;
+  if (!arc_free(checker, arc, start_clearance, sign * lo, end_clearance)) return 0.0;
+  double hi = last_free;
+  constexpr int kBisections = 5;
+  for (int i = 0; i < kBisections; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (arc_free(checker, arc, start_clearance, sign * mid, end_clearance) ? lo : hi) = mid;
+  }
+  return lo;
 }
 
 bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance,

@@ -36,30 +36,26 @@ class Arc {
   double curvature_{0.0};
 };
 
-// The collision tests of a swept footprint: `exact` for the poses where the search stops, and
-// `swept`, the same footprint grown by `growth` [m] on every side, for the motion in between;
-// where that refuses a stretch, `fine` (grown by `fine_growth` < growth) re-tests it in shorter
-// stretches, so that the refusal is only as conservative as fine_growth.
-struct SweepCheckers {
-  const GridCollisionChecker& exact;
-  const GridCollisionChecker& swept;
-  double growth{0.0};
-  const GridCollisionChecker& fine;
-  double fine_growth{0.0};
-};
-
 // True when the footprint stays clear of every occupied cell over the whole arc, the motion
 // between the poses tested included. The start is known to be free with clearance lower bound
 // `start_clearance` [m] (0 when unknown beyond being free) and is not tested again; the end is
-// tested with the exact footprint and `end_clearance` receives its clearance bound.
+// tested exactly and `end_clearance` receives its clearance bound.
 //
-// In between, while the footprint drives a length l on the arc, no point of it moves farther than
-// sweep_factor * l, so over [s - u, s + u] (u = growth / sweep_factor) the body stays inside the
-// footprint at s grown by `growth`: one test of the grown footprint covers that stretch, and its
-// clearance bound c widens it by c / sweep_factor each way. The test is conservative (a sweep that
-// passes within `fine_growth` of an occupied cell is refused), never optimistic.
-bool arc_free(const SweepCheckers& checkers, const Arc& arc, double start_clearance, double distance,
+// While the vehicle drives a length l on the arc no point of it moves farther than
+// sweep_factor * l, so the clearance bounds of the start and the end prove stretches next to them
+// free. The rest is covered by hull tests (GridCollisionChecker::sweep_collides) of poses at most
+// 0.15 rad apart in heading, grown by the sagitta of that turn (at most 1.5 cm for a body point
+// 5.5 m from the turning centre): conservative by that much, never optimistic.
+bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
               double& end_clearance);
+
+// The length [m] of a collision-free prefix of the arc ("drive until contact"), at least
+// `min_length`, or 0 when there is none: the motion is driven until a sample (a cell of body
+// motion apart) collides, and the longest prefix up to the last free sample that arc_free accepts
+// is found by bisection (to 1/32 of the interval). The start is known to be free with clearance
+// bound `start_clearance`, as for arc_free.
+double free_prefix(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+                   double min_length);
 
 // A quick necessary condition for arc_free: the poses every `spacing` [m] along the arc and its
 // end are free (exact tests). Most arcs that collide fail here at a fraction of the cost.

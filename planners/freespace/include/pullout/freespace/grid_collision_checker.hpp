@@ -29,6 +29,16 @@ class GridCollisionChecker {
   // The same with cos(pose.yaw) and sin(pose.yaw) given (callers that already have them).
   bool collides(const Pose2& pose, double cos_yaw, double sin_yaw, double& clearance_bound) const;
 
+  // True when the convex hull of the footprints at `a` and `b`, grown by `margin` [m] on every
+  // side, touches an occupied cell or leaves the grid (exact, as collides()). A body point moving
+  // on a circular arc (or a line) from its place at a to its place at b stays within the arc's
+  // sagitta of its chord, and the chord lies in the hull: with margin >= the largest sagitta
+  // (sweep_margin), a false answer proves the whole motion between a and b free.
+  bool sweep_collides(const Pose2& a, const Pose2& b, double margin) const;
+  // The largest sagitta [m] of a footprint point's path while the vehicle turns by `turn` [rad]
+  // on an arc of curvature `curvature` [1/m] (0 on a straight line).
+  double sweep_margin(double curvature, double turn) const;
+
   // A lower bound [m] of the distance from the footprint at `pose` to the nearest occupied cell
   // (0 when it may touch one). Cheap: a few distance-transform lookups.
   double clearance_lower_bound(const Pose2& pose) const;
@@ -72,6 +82,7 @@ class GridCollisionChecker {
   // collides_exact).
   int pieces_x_{1};
   int pieces_y_{1};
+  int sweep_pieces_{1};  // pieces along the body of sweep_collides
 };
 
 }  // namespace pullout

@@ -52,13 +52,26 @@
 
 namespace pullout {
 
+constexpr int kMaxTurningSteps = 10;  // HybridAStarConfig::turning_steps at most (clamped to 1..this)
+
 struct HybridAStarConfig {
   double turning_radius{5.0};    // [m] radius of the sharpest primitive and of the shots, > 0
   int turning_steps{1};          // curvatures per side: steer index -turning_steps..turning_steps
   int theta_size{120};           // heading bins of the lattice
   double primitive_length{0.5};  // [m] arc length of one motion primitive
   double xy_resolution{0.0};     // [m] lattice cell; 0 = primitive_length (see the note above)
-  bool use_back{true};           // expand reverse primitives
+  // The lattice of the children of constrained nodes (see the note above): cell [m] and heading
+  // bins (theta_size times this).
+  double fine_xy_resolution{0.02};
+  int fine_theta_factor{4};
+  // [m] a primitive that would collide is cut to its free part when that is at least this long
+  // ("drive until contact") at constrained nodes, whose children also get the fine lattice; 0 = off
+  // (the plain search). Off by default: TPCAP 20/20 with 0.02 and search_from_goal, but cases 9
+  // and 19 take seconds (bench/RESULTS.md).
+  double min_primitive_length{0.0};
+  bool use_back{true};  // expand reverse primitives
+  // Also search from the goal when it lies in a tight spot (see the note above); needs use_back.
+  bool search_from_goal{false};
   double curve_weight{0.5};
   double reverse_weight{1.0};
   double direction_change_weight{1.5};    // [m] added per change of driving direction
@@ -94,6 +107,7 @@ struct HybridAStarResult {
   std::size_t nodes{0};
   std::size_t shots{0};            // Reeds-Shepp analytic expansions tried
   bool reached_exact_goal{false};  // by a Reeds-Shepp shot (else: inside the goal region)
+  bool found_from_goal{false};     // by the search from the goal (then the goal is exact)
 };
 
 const char* to_string(HybridAStarResult::Status status);
