@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "pullout/freespace/grid_collision_checker.hpp"
+#include "pullout/freespace/path_smoother.hpp"
 #include "pullout/geometry/angle.hpp"
 #include "pullout/geometry/polyline.hpp"
 
@@ -19,6 +20,15 @@ constexpr double kWindowExtra = 10.0;  // [m] costmap window beyond the farthest
 // The pair of a partial path that stops at its end: v reached at half of it (a = v^2 / L).
 TerminalVelocityAccel stopping_pair(double v, double length) {
   return {v, length > 1e-9 ? v * std::abs(v) / length : 0.0};
+}
+
+// The path smoothed within `stop` when the parameters ask for it (path_smoother.hpp).
+void smooth_if_asked(const FreespaceParameters& p, const GridCollisionChecker& checker, const HybridAStarConfig& search,
+                     std::vector<Waypoint>& waypoints, const StopCondition& stop) {
+  if (!p.smooth_path) return;
+  PathSmootherConfig config;
+  config.max_curvature = 1.0 / search.turning_radius;
+  waypoints = smooth_path(waypoints, checker, config, stop).waypoints;
 }
 
 }  // namespace
@@ -125,7 +135,9 @@ FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const Vehicle
   out.stopped = r.stopped;
   out.expansions = r.expansions;
   if (r.status != HybridAStarResult::Status::kSuccess) return out;
-  SplitPath split = split_at_cusps(r.waypoints, p.velocity);
+  std::vector<Waypoint> waypoints = r.waypoints;
+  smooth_if_asked(p, checker, config, waypoints, stop);
+  SplitPath split = split_at_cusps(waypoints, p.velocity);
   out.path.partial_paths = std::move(split.partial_paths);
   out.path.pairs_terminal_velocity_and_accel = std::move(split.pairs);
   out.path.start_pose = start;
@@ -178,6 +190,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
       if (r.status == HybridAStarResult::Status::kStartOccupied) break;  // the same for every end pose
       continue;
     }
+    smooth_if_asked(p, checker, search.config(), r.waypoints, until);
     PathCandidate candidate;
     std::vector<Pose2> poses;
     for (const Waypoint& w : r.waypoints) poses.push_back(w.pose);

@@ -244,6 +244,8 @@ const Table<FreespaceParameters>& freespace_table() {
                               field("max_turning_ratio", &T::max_turning_ratio, "", in(0.05, 1.0),
                                     "x vehicle.max_steer_angle for the motion primitives"),
                               field("turning_steps", &T::turning_steps, "", in(1, 10), "steering angles per side"),
+                              field("smooth_path", &T::smooth_path, "", AnyValue{},
+                                    "(not Autoware) smooth each direction segment, cusps kept"),
                               group("search_configs", &T::search_configs, &search_configs_table, ""),
                               group("costmap_configs", &T::costmap_configs, &costmap_configs_table, ""),
                               group("astar", &T::astar, &astar_table, ""),

@@ -15,6 +15,8 @@ struct FreespaceParameters {
   double time_limit{3000.0};                    // [ms] search budget (the request deadline may cut it shorter)
   double max_turning_ratio{0.7};                // x max_steer_angle for the primitives (0, 1]
   int turning_steps{1};                         // steering angles per side
+  // Not in Autoware: smooth each direction segment of the path, cusps kept (path_smoother.hpp).
+  bool smooth_path{true};
   struct SearchConfigs {
     int theta_size{120};                  // heading bins of the lattice
     double angle_goal_range{6.0};         // [deg] goal region width in heading
