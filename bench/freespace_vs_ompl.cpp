@@ -52,6 +52,7 @@
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/freespace/hybrid_astar.hpp"
+#include "pullout/freespace/path_smoother.hpp"
 #include "pullout/freespace/reeds_shepp.hpp"
 #include "pullout/geometry/angle.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
@@ -180,6 +181,12 @@ struct Run {
   std::size_t expansions{0};
   int status{0};  // ours: HybridAStarResult::Status
   bool from_goal{false};
+  // Ours: the path's shape before and after path_smoother, and the smoothing time.
+  pullout::PathShape raw;
+  pullout::PathShape smooth;
+  double smooth_ms{0.0};
+  int segments{0};
+  int refused{0};
 };
 
 Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
@@ -227,7 +234,55 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   for (std::size_t i = 1; i < r.waypoints.size(); ++i) {
     run.direction_changes += r.waypoints[i].direction != r.waypoints[i - 1].direction ? 1 : 0;
   }
+  if (run.success) {
+    pullout::PathSmootherConfig smoother;
+    smoother.max_curvature = 1.0 / radius;
+    const auto s0 = std::chrono::steady_clock::now();
+    const pullout::SmoothedPath smoothed = pullout::smooth_path(r.waypoints, checker, smoother);
+    run.smooth_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count();
+    run.raw = pullout::path_shape(r.waypoints);
+    run.smooth = pullout::path_shape(smoothed.waypoints);
+    run.segments = smoothed.segments;
+    run.refused = smoothed.refused;
+  }
   return run;
+}
+
+// Ours before and after smoothing (path_smoother.hpp), over the solved problems.
+void print_smoothing(const std::vector<Run>& runs) {
+  std::vector<double> times;
+  double n = 0.0, segments = 0.0, refused = 0.0;
+  pullout::PathShape raw, smooth;
+  double raw_kmax = 0.0, smooth_kmax = 0.0;
+  for (const Run& r : runs) {
+    if (!r.success) continue;
+    n += 1.0;
+    times.push_back(r.smooth_ms);
+    segments += r.segments;
+    refused += r.refused;
+    raw.length += r.raw.length;
+    smooth.length += r.smooth.length;
+    raw.curvature_variation += r.raw.curvature_variation;
+    smooth.curvature_variation += r.smooth.curvature_variation;
+    raw.max_curvature_rate += r.raw.max_curvature_rate;
+    smooth.max_curvature_rate += r.smooth.max_curvature_rate;
+    raw.curvature_energy += r.raw.curvature_energy;
+    smooth.curvature_energy += r.smooth.curvature_energy;
+    raw_kmax = std::max(raw_kmax, r.raw.max_curvature);
+    smooth_kmax = std::max(smooth_kmax, r.smooth.max_curvature);
+  }
+  if (n == 0.0) return;
+  std::sort(times.begin(), times.end());
+  std::printf("\nsmoothing (hybrid A*, %.0f solved problems; means per path unless noted)\n", n);
+  std::printf(
+      "| path | length [m] | max curvature, all paths [1/m] | sum abs(dk) [1/m] | max abs(dk/ds) [1/m^2] | sum dk^2/ds "
+      "[1/m^3] |\n|---|---|---|---|---|---|\n");
+  std::printf("| search output | %.2f | %.4f | %.3f | %.3f | %.4f |\n", raw.length / n, raw_kmax,
+              raw.curvature_variation / n, raw.max_curvature_rate / n, raw.curvature_energy / n);
+  std::printf("| smoothed | %.2f | %.4f | %.3f | %.3f | %.4f |\n", smooth.length / n, smooth_kmax,
+              smooth.curvature_variation / n, smooth.max_curvature_rate / n, smooth.curvature_energy / n);
+  std::printf("smoothing time: median %.2f ms, max %.2f ms; segments %.0f, refused (kept as searched) %.0f\n",
+              times[times.size() / 2], times.back(), segments, refused);
 }
 
 Run run_ompl(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
@@ -469,5 +524,6 @@ int main(int argc, char** argv) {
   }
   std::printf("\nhybrid A* median on 30 m x 30 m at 0.2 m: %.1f ms (%zu problems)\n", percentile(small_ours, 0.5),
               small_ours.size());
+  print_smoothing(runs[0]);
   return 0;
 }

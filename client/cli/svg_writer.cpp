@@ -258,6 +258,58 @@ double nice_scale_length(double max_length_m) {
   return decade;
 }
 
+// Freespace elements: the request's occupancy grid as its occupied cells (merged into runs along
+// each row), what the freespace search avoided.
+void draw_grid(std::ostringstream& svg, const Frame& f, const PullOutRequest& request) {
+  if (!request.occupancy_grid) return;
+  const OccupancyGrid& g = *request.occupancy_grid;
+  const double c = std::cos(g.origin.yaw);
+  const double s = std::sin(g.origin.yaw);
+  const auto at = [&](double u, double v) { return Point2{g.origin.x + c * u - s * v, g.origin.y + s * u + c * v}; };
+  svg << "  <g id=\"grid\">\n";
+  for (std::uint32_t j = 0; j < g.height; ++j) {
+    std::uint32_t i = 0;
+    while (i < g.width) {
+      const auto occupied = [&](std::uint32_t k) {
+        const int v = g.data[static_cast<std::size_t>(j) * g.width + k];
+        return v < 0 || v >= 50;
+      };
+      if (!occupied(i)) {
+        ++i;
+        continue;
+      }
+      std::uint32_t end = i;
+      while (end < g.width && occupied(end)) ++end;
+      const double r = g.resolution_m;
+      const std::vector<Point2> run{at(i * r, j * r), at(end * r, j * r), at(end * r, (j + 1) * r),
+                                    at(i * r, (j + 1) * r)};
+      svg << "    <polygon class=\"grid-occupied\" points=\"" << points_attr(f, run)
+          << "\" fill=\"#7f7f7f\" stroke=\"none\"/>\n";
+      i = end;
+    }
+  }
+  svg << "  </g>\n";
+}
+
+// The footprint where the vehicle stops to change direction (the last point of every partial
+// path followed by one in the other direction), numbered in driving order.
+void draw_cusp_footprints(std::ostringstream& svg, const Frame& f, const VehicleInfo& vehicle,
+                          const PullOutPath* path) {
+  svg << "  <g id=\"cusps\">\n";
+  if (path_drawn(path)) {
+    int number = 0;
+    for (std::size_t i = 0; i + 1 < path->partial_paths.size(); ++i) {
+      const auto& a = path->partial_paths[i];
+      if (a.points.empty() || segment_is_reverse(a) == segment_is_reverse(path->partial_paths[i + 1])) continue;
+      draw_footprint(svg, f, vehicle, a.points.back().pose, "footprint-cusp", "#7030a0");
+      const Pose2& p = a.points.back().pose;
+      svg << "    <text class=\"cusp-label\" x=\"" << num(f.x(p.x) + 4.0) << "\" y=\"" << num(f.y(p.y) - 4.0)
+          << "\" fill=\"#7030a0\">cusp " << ++number << "</text>\n";
+    }
+  }
+  svg << "  </g>\n";
+}
+
 std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle, const PullOutPath* path,
                        const SvgOptions& options) {
   // --- what is drawn, and its bounding box ---
@@ -345,6 +397,9 @@ std::string render_svg(const PullOutRequest& request, const VehicleInfo& vehicle
         << "\" fill-opacity=\"0.7\" stroke=\"" << kObjectStroke << "\" stroke-width=\"1\"/>\n";
   }
   svg << "  </g>\n";
+
+  draw_grid(svg, f, request);
+  draw_cusp_footprints(svg, f, vehicle, path);
 
   svg << "  <g id=\"footprints\">\n";
   draw_footprint(svg, f, vehicle, request.ego_pose, "footprint-start", kStartStroke);

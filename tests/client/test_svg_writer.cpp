@@ -262,3 +262,46 @@ TEST(SvgWriter, DrawsMapLaneletsAndOutlinesTheRoute) {
 
 }  // namespace
 }  // namespace pullout::cli
+
+namespace pullout::cli {
+namespace {
+
+TEST(RenderSvg, FreespaceShowsTheGridAndAFootprintAtEveryCusp) {
+  // A 4 x 2 cell grid with two occupied runs (row 0: cells 1-2; row 1: cell 3 unknown) and a
+  // path forward, reverse, forward: two cusps, three segments.
+  PullOutRequest request = scene();
+  OccupancyGrid g;
+  g.resolution_m = 1.0;
+  g.width = 4;
+  g.height = 2;
+  g.data = {0, 100, 100, 0, 0, 0, 0, -1};
+  request.occupancy_grid = g;
+  PullOutPath p;
+  p.found = true;
+  p.planner_type = PlannerType::kFreespace;
+  const double v[3] = {1.0, -1.0, 1.0};
+  for (int s = 0; s < 3; ++s) {
+    PathWithLaneId seg;
+    for (int i = 0; i <= 4; ++i) seg.points.push_back({{5.0 + i * v[s], 1.0 + s, 0.0}, i == 4 ? 0.0 : v[s], {}});
+    p.partial_paths.push_back(seg);
+    p.pairs_terminal_velocity_and_accel.push_back({v[s], 0.0});
+  }
+  p.start_pose = p.partial_paths[0].points[0].pose;
+  p.end_pose = p.partial_paths[2].points.back().pose;
+  Parsed parsed;
+  parse(render_svg(request, VehicleInfo{}, &p, {}), parsed);
+  EXPECT_EQ(with_class(parsed, "grid-occupied").size(), 2u);
+  EXPECT_EQ(with_class(parsed, "footprint-cusp").size(), 2u);
+  EXPECT_EQ(with_class(parsed, "cusp-label").size(), 2u);
+  // Without cusps (one direction) and without a grid: none.
+  p.partial_paths.resize(1);
+  p.pairs_terminal_velocity_and_accel.resize(1);
+  request.occupancy_grid.reset();
+  Parsed plain;
+  parse(render_svg(request, VehicleInfo{}, &p, {}), plain);
+  EXPECT_TRUE(with_class(plain, "grid-occupied").empty());
+  EXPECT_TRUE(with_class(plain, "footprint-cusp").empty());
+}
+
+}  // namespace
+}  // namespace pullout::cli
