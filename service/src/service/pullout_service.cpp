@@ -72,8 +72,7 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
       metrics_(make_metrics(config)),
       dds_(config.dds, config.service.replica),
       journal_(make_journal(config, dds_)),
-      planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map),
-               config.vehicle_profiles),
+      planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map), config.vehicle_profiles),
       registry_(planner_, journal_ ? static_cast<Outbox&>(*journal_) : dds_,
                 registry_options(config.service, metrics_.get())) {
   health_.config_loaded = true;  // load_config validated it
