@@ -63,7 +63,8 @@ TEST_F(Watch, ShowsEveryVehicleWithItsStateAndSegment) {
 
   const auto waiting = connect("watch-waiting");
   ASSERT_NE(waiting, nullptr);
-  const Scenario straight = load_test_scenario("straight_shoulder");
+  Scenario straight = load_test_scenario("straight_shoulder");
+  translate(straight.request, 1000.0, 0.0);  // far away: not held for the driven vehicle's path
   const std::uint64_t waiting_id = waiting->send(straight.request);
   const auto waiting_status = waiting->wait_for_status(
       waiting_id, [](const PullOutStatus& s) { return s.state == ExecutionState::kWaitingApproval; }, kReplyTimeout);

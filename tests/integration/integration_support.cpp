@@ -22,6 +22,33 @@ Scenario load_test_scenario(const std::string& name) {
   return load_scenario(scenario_path(name), load_config(default_config_path()));
 }
 
+void translate(PullOutRequest& request, double dx, double dy) {
+  const auto move_pose = [dx, dy](Pose2& p) {
+    p.x += dx;
+    p.y += dy;
+  };
+  const auto move_points = [dx, dy](std::vector<Point2>& points) {
+    for (Point2& p : points) {
+      p.x += dx;
+      p.y += dy;
+    }
+  };
+  move_pose(request.ego_pose);
+  move_pose(request.goal_pose);
+  for (Lane& lane : request.lanes) {
+    move_points(lane.left_bound);
+    move_points(lane.right_bound);
+    move_points(lane.centerline);
+  }
+  for (Object& o : request.objects) {
+    move_pose(o.pose);
+    for (PredictedPath& path : o.predicted_paths) {
+      for (Pose2& p : path.poses) move_pose(p);
+    }
+  }
+  if (request.occupancy_grid) move_pose(request.occupancy_grid->origin);
+}
+
 void expect_found_path_invariants(const PullOutPath& path) {
   EXPECT_TRUE(path.found);
   ASSERT_GE(path.partial_paths.size(), 1u);

@@ -31,6 +31,11 @@ std::string loopback_profiles_path();                  // config/dds/loopback.xm
 // The scenario on top of config/pullout.yaml (what the service plans with).
 Scenario load_test_scenario(const std::string& name);
 
+// The request moved by (dx, dy) in the map frame (poses, lanes, objects and their predictions,
+// the grid's origin): two test vehicles on one service are then far apart, so that neither is
+// held for the other's path (vehicles that see each other, issue 15). Inline lanes only.
+void translate(PullOutRequest& request, double dx, double dy);
+
 // Checks the invariants of a found PullOutPath (DESIGN.md): found, pairs == partial paths >= 1,
 // every partial path >= 2 finite points, constant driving direction inside a partial path,
 // consecutive partial paths join.

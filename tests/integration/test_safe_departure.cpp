@@ -115,8 +115,11 @@ TEST_F(SafeDeparture, FastCarFromBehindHoldsUntilItIsGone) {
 
 TEST_F(SafeDeparture, FarCarAndCarThatCouldNotPassDoNotHold) {
   start_service();
+  double offset_m = 0.0;  // the second vehicle 1 km away: not held for the first one's path
   for (const char* name : {"traffic_far_behind", "traffic_cannot_pass"}) {
-    const Scenario scenario = load_test_scenario(name);
+    Scenario scenario = load_test_scenario(name);
+    translate(scenario.request, offset_m, 0.0);
+    offset_m += 1000.0;
     auto client = connect(std::string("int-") + name);
     ASSERT_NE(client, nullptr);
     const std::uint64_t id = client->send(scenario.request);
