@@ -107,31 +107,34 @@ void StateJournal::on_request(const msg::PullOutRequest& sample) {
   r.pending_request_id = sample.request_id();
 }
 
+// Write-ahead: the state is on disk before a vehicle can see it, so a process killed right after a
+// publication never restarts behind what the vehicle was told (it failed as
+// RestartWithoutLoss.AVehicleInMidManoeuvre... when the kill came between the two).
 bool StateJournal::publish_path(const PullOutPath& path) {
-  const bool ok = next_.publish_path(path);
-  if (!ok) return ok;
   std::string cdr = to_cdr<msg::PullOutPathPubSubType>(idl::to_msg(path));
-  std::lock_guard<std::mutex> lock(mutex_);
-  Record& r = records_[path.vehicle_id];
-  r.path = std::move(cdr);
-  // Written with the status that follows (a path is always followed by its status).
-  return ok;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Record& r = records_[path.vehicle_id];
+    r.path = std::move(cdr);
+    // Written with the status that follows (a path is always followed by its status).
+  }
+  return next_.publish_path(path);
 }
 
 bool StateJournal::publish_status(const PullOutStatus& status) {
-  const bool ok = next_.publish_status(status);
-  if (!ok) return ok;
   std::string cdr = to_cdr<msg::PullOutStatusPubSubType>(idl::to_msg(status));
-  std::lock_guard<std::mutex> lock(mutex_);
-  Record& r = records_[status.vehicle_id];
-  r.status = std::move(cdr);
-  if (!r.pending_request.empty() && r.pending_request_id == status.request_id) {
-    r.request = std::move(r.pending_request);
-    r.pending_request.clear();
-    r.pending_request_id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Record& r = records_[status.vehicle_id];
+    r.status = std::move(cdr);
+    if (!r.pending_request.empty() && r.pending_request_id == status.request_id) {
+      r.request = std::move(r.pending_request);
+      r.pending_request.clear();
+      r.pending_request_id = 0;
+    }
+    write(status.vehicle_id, r);
   }
-  write(status.vehicle_id, r);
-  return ok;
+  return next_.publish_status(status);
 }
 
 bool StateJournal::forget_vehicle(const std::string& vehicle_id) {
