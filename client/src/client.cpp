@@ -303,6 +303,7 @@ class __attribute__((visibility("hidden"))) Client::Impl final : public client_d
   std::optional<std::uint32_t> current_segment() const;
   bool wait_for_service(Duration timeout) const;
   ServiceState service_state() const;
+  std::size_t matched_services() const;
 
   const ClientOptions& options() const { return options_; }
 
@@ -1439,6 +1440,11 @@ std::optional<PullOutStatus> Client::Impl::latest_status() const {
   return *recent_statuses_.back().value;
 }
 
+std::size_t Client::Impl::matched_services() const {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  return static_cast<std::size_t>(std::max(request_matches_, 0));
+}
+
 ServiceState Client::Impl::service_state() const {
   std::lock_guard<std::mutex> lock(state_mutex_);
   return service_state_;
@@ -1497,6 +1503,7 @@ std::uint64_t Client::current_request_id() const { return impl_->current_request
 std::optional<std::uint32_t> Client::current_segment() const { return impl_->current_segment(); }
 bool Client::wait_for_service(Duration timeout) const { return impl_->wait_for_service(timeout); }
 ServiceState Client::service_state() const { return impl_->service_state(); }
+std::size_t Client::matched_services() const { return impl_->matched_services(); }
 const std::string& Client::vehicle_id() const { return impl_->options().vehicle_id; }
 int Client::domain_id() const { return impl_->options().domain_id; }
 

@@ -243,7 +243,19 @@ TEST_P(Replicas, TheServingReplicaKilledMidManoeuvreIsReplacedWithTheSamePathAnd
   ASSERT_EQ(path->partial_paths.size(), 2u) << "reverse, shift";
   std::vector<std::unique_ptr<ServiceProcess>> standby;
   for (int i = 1; i < replicas; ++i) {
-    standby.push_back(std::make_unique<ServiceProcess>(options_for(lease_.domain(), cfg)));
+    ServiceOptions o = options_for(lease_.domain(), cfg);
+    o.log_level = "info";  // for "in step" below
+    standby.push_back(std::make_unique<ServiceProcess>(o));
+  }
+  // A standby serves nothing until it holds the other replicas' vehicles (their paths and
+  // statuses); it says so in its log.
+  for (auto& s : standby) {
+    const auto in_step_deadline = SteadyClock::now() + kMatchTimeout;
+    while (s->stderr_tail(100000).find("replica: in step") == std::string::npos &&
+           SteadyClock::now() < in_step_deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_NE(s->stderr_tail(100000).find("replica: in step"), std::string::npos) << s->stderr_tail();
   }
   // Approved, it drives segment 0 and stands at its end until the service says segment 1.
   Driver driver(*client, id, *path);
@@ -252,6 +264,13 @@ TEST_P(Replicas, TheServingReplicaKilledMidManoeuvreIsReplacedWithTheSamePathAnd
   // Like Autoware's planner every cycle, the vehicle sends its request again (same goal, from
   // where it stands): the departed vehicle's path is latched, only the request id changes. The
   // replicas started after the first request see this one: it gives them the lanes and objects.
+  // A replica that has not matched the vehicle's request writer would never see this request
+  // (volatile topic) and could not take the vehicle over with its world.
+  const auto match_deadline = SteadyClock::now() + kMatchTimeout;
+  while (client->matched_services() < static_cast<std::size_t>(replicas) && SteadyClock::now() < match_deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(client->matched_services(), static_cast<std::size_t>(replicas));
   PullOutRequest again_request = scenario.request;
   again_request.ego_pose = path->partial_paths[0].points.back().pose;
   const std::uint64_t id2 = client->send(again_request);
@@ -268,14 +287,14 @@ TEST_P(Replicas, TheServingReplicaKilledMidManoeuvreIsReplacedWithTheSamePathAnd
       id2, [&](const PullOutStatus& s) { return s.stamp_ns > killed_ns; }, kReplyTimeout);
   const double gap_s = std::chrono::duration<double>(SteadyClock::now() - killed_at).count();
   std::string logs;
-  for (auto& s : standby) logs += s->stderr_tail() + "\n---\n";
+  for (auto& s : standby) logs += s->stderr_tail(60000) + "\n---\n";
   ASSERT_TRUE(again) << logs;
   std::printf("[ replicas ] %d replicas: takeover %.3f s after SIGKILL (lease 500 ms)\n", replicas, gap_s);
   RecordProperty("takeover_s", std::to_string(gap_s));
   EXPECT_LT(gap_s, 3.0) << "target < 1 s on an idle machine";
   serving.reset();  // reaps it
   EXPECT_EQ(again->request_id, id2);
-  EXPECT_EQ(again->current_path_idx, 1u);
+  EXPECT_EQ(again->current_path_idx, 1u) << again->stop_reason << "\n" << logs;
   EXPECT_TRUE(again->departed);
   EXPECT_EQ(again->state, ExecutionState::kExecuting);
   const auto republished = wait_for_path_after(*client, killed_ns);

@@ -656,6 +656,36 @@ TEST_F(RestoredSession, WithoutTheRequestsWorldNothingMayDrive) {
   EXPECT_NE(status().state, ExecutionState::kExecuting);
 }
 
+// A replica that took the vehicle over saw its re-sent request but not the status that answered
+// it: the later request gives the world, and handled after the restore it latches onto the path.
+TEST_F(RestoredSession, WithTheWorldOfALaterRequestTheVehicleKeepsItsSegmentUnderThatRequest) {
+  drive_to_second_segment();
+  PullOutRequest later = sc_.request;
+  later.request_id = sc_.request.request_id + 1;
+  later.stamp_ns = sc_.request.stamp_ns + 1'000'000'000;
+  later.ego_pose = end_of_segment(found_, 0);
+  SessionSnapshot snap = snapshot();
+  snap.request = later;
+  snap.request_is_later = true;
+  const SessionEffects e = restore_into_new(snap);
+  ASSERT_TRUE(e.status);
+  EXPECT_EQ(e.status->state, ExecutionState::kExecuting);
+  EXPECT_EQ(e.status->request_id, sc_.request.request_id);
+  const SessionEffects again = session_->on_request(later, {}, now_);
+  EXPECT_FALSE(again.search) << "a departed vehicle's path is latched, not planned again";
+  ASSERT_TRUE(again.status && again.path);
+  EXPECT_EQ(again.status->request_id, later.request_id);
+  EXPECT_EQ(again.status->current_path_idx, 1u);
+  EXPECT_TRUE(again.status->departed);
+  EXPECT_EQ(again.status->state, ExecutionState::kExecuting);
+  EXPECT_EQ(again.path->partial_paths.size(), found_.partial_paths.size());
+  // Without the flag, a request that is not the one the status answers gives no world.
+  snap.request_is_later = false;
+  const SessionEffects refused = restore_into_new(snap);
+  ASSERT_TRUE(refused.status);
+  EXPECT_EQ(refused.status->state, ExecutionState::kNoPath);
+}
+
 TEST_F(RestoredSession, AWaitingVehicleStillNeedsItsApproval) {
   sc_ = scenario("car_close_ahead");
   use(sc_);

@@ -369,10 +369,15 @@ SessionEffects VehicleSession::restore(const SessionSnapshot& snapshot,
   status_ = st;
   status_.vehicle_id = vehicle_id_;
   SessionEffects out;
-  const bool found = snapshot.path && snapshot.path->found && !snapshot.path->partial_paths.empty() &&
-                     !snapshot.path->partial_paths.front().points.empty() && snapshot.path->request_id == st.request_id;
+  // With a later request, the path may already carry its id (the owner latched the path onto it
+  // and left before its status went out).
+  const bool path_answers =
+      snapshot.path && (snapshot.path->request_id == st.request_id ||
+                        (snapshot.request_is_later && snapshot.path->request_id == request.request_id));
+  const bool found = path_answers && snapshot.path->found && !snapshot.path->partial_paths.empty() &&
+                     !snapshot.path->partial_paths.front().points.empty();
   if (has_path(st.state) || st.state == ExecutionState::kPlanning) {
-    if (!found || !world || request.request_id != st.request_id) {
+    if (!found || !world || (request.request_id != st.request_id && !snapshot.request_is_later)) {
       // No safety check without the world the path was planned on: nothing may drive.
       status_ = make_status(st.request_id, ExecutionState::kNoPath);
       status_.stop_reason = "service takeover: the request " + std::to_string(st.request_id) +
@@ -386,10 +391,12 @@ SessionEffects VehicleSession::restore(const SessionSnapshot& snapshot,
       return out;
     }
     path_ = *snapshot.path;
-    published_ = *snapshot.path;
+    path_->request_id = st.request_id;
+    published_ = *path_;
     tracker_.resume(*path_, st.current_path_idx, st.state == ExecutionState::kCompleted);
     status_.current_path_idx = tracker_.current_path_idx();
-    safety_.emplace(planner_.parameters(), planner_.vehicle(), world->lanes, world->objects, *path_);
+    planned_vehicle_ = world->vehicle;  // a van's path is checked with the van's footprint
+    safety_.emplace(planner_.parameters(), planned_vehicle_, world->lanes, world->objects, *path_);
     // A stop inserted before the takeover is in the published path: resume like after one.
     stop_inserted_ = st.departed && st.state == ExecutionState::kWaitingSafety;
     signal_on_at_ = now;  // prepare time measured afresh here: never shorter than asked

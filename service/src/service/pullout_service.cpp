@@ -1,15 +1,18 @@
 #include "service/pullout_service.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <exception>
 #include <iterator>
 #include <mutex>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include <spdlog/spdlog.h>
 #include <fastdds/dds/core/condition/StatusCondition.hpp>
 #include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
@@ -176,6 +179,7 @@ void PulloutService::dispatch_loop() {
   }
   spdlog::debug("dispatcher running");
   health_.beat();
+  if (shadows_) sync_with_replicas();
 
   auto last_time_tick = std::chrono::steady_clock::now();
   while (!stopping_) {
@@ -189,11 +193,11 @@ void PulloutService::dispatch_loop() {
     health_.beat();
     dds_.prepare_discovered_vehicles();
     // Both readers are drained on every wake-up: cheap when empty, and it cannot miss data.
-    if (shadows_) {
-      take_replica_samples();
-      take_over_departed();
-    }
+    // Requests before the takeover: a request for a vehicle of a replica that just left is kept
+    // for the takeover (its world), not planned afresh.
+    if (shadows_) take_replica_samples();
     take_requests();
+    if (shadows_) take_over_departed();
     take_progress();
     const auto now = std::chrono::steady_clock::now();
     if (now - last_time_tick >= kSessionTimePeriod) {
@@ -237,10 +241,14 @@ void PulloutService::take_requests() {
         if (!sender_allowed(info, sample.vehicle_id(), "request")) continue;
         request_instances_[info.instance_handle] = sample.vehicle_id();
         if (shadows_ && !serving(sample.vehicle_id())) {
-          // Another replica serves it: kept for a takeover (decoded and validated then).
+          // Another replica serves it, or served it and left (this one may take it over next):
+          // kept for a takeover (decoded and validated then).
           std::vector<RequestIssue> issues;
           PullOutRequest request = idl::from_msg(sample, issues);
-          if (issues.empty() && sample.vehicle_id().size() <= kMaxVehicleIdBytes) shadows_->keep_request(request);
+          if (issues.empty() && sample.vehicle_id().size() <= kMaxVehicleIdBytes) {
+            shadows_->keep_request(request);
+            spdlog::debug("vehicle '{}' request {}: kept for a takeover", request.vehicle_id, request.request_id);
+          }
           continue;
         }
         handle_request(sample);
@@ -276,10 +284,14 @@ void PulloutService::take_progress() {
 }
 
 bool PulloutService::serving(const std::string& vehicle_id) const {
-  return registry_.holds(vehicle_id) || shadows_->serves(vehicle_id, dds_.self(), dds_.replicas());
+  if (registry_.holds(vehicle_id)) return true;
+  const ParticipantId self = dds_.self();
+  const std::vector<ParticipantId> others = dds_.replicas();
+  return !shadows_->owner_left(vehicle_id, self, others) && shadows_->serves(vehicle_id, self, others);
 }
 
-void PulloutService::take_replica_samples() {
+std::size_t PulloutService::take_replica_samples() {
+  std::size_t taken = 0;
   const ParticipantId self = dds_.self();
   const auto writer_of = [](const dds::SampleInfo& info) {
     return eprosima::fastrtps::rtps::iHandle2GUID(info.publication_handle).guidPrefix;
@@ -304,6 +316,7 @@ void PulloutService::take_replica_samples() {
     msg::PullOutPath sample;
     dds::SampleInfo info;
     while (!stopping_ && dds_.replica_path_reader()->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      ++taken;
       if (!info.valid_data) continue;
       if (ReplicaShadows::Shadow* s = note_owner(sample.vehicle_id(), writer_of(info))) s->path = idl::from_msg(sample);
     }
@@ -311,6 +324,7 @@ void PulloutService::take_replica_samples() {
   msg::PullOutStatus sample;
   dds::SampleInfo info;
   while (!stopping_ && dds_.replica_status_reader()->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+    ++taken;
     if (!info.valid_data) {
       // Disposed: the owner evicted the vehicle (not the owner dying: that is no writers).
       const auto it = replica_status_instances_.find(info.instance_handle);
@@ -321,6 +335,59 @@ void PulloutService::take_replica_samples() {
     }
     replica_status_instances_[info.instance_handle] = sample.vehicle_id();
     if (ReplicaShadows::Shadow* s = note_owner(sample.vehicle_id(), writer_of(info))) s->status = idl::from_msg(sample);
+  }
+  return taken;
+}
+
+void PulloutService::sync_with_replicas() {
+  // A replica that starts while others serve must know their vehicles before it answers a request:
+  // a vehicle whose owner it has not heard of yet would otherwise be planned afresh here too (the
+  // rendezvous winner for a vehicle without a known owner). Requests that arrive meanwhile wait in
+  // the reader. Bounded: about one lease to discover the other replicas (they announce every
+  // quarter of a lease), then at most three more for their writers to match and their history
+  // (TRANSIENT_LOCAL paths and statuses) to arrive.
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  const auto lease = std::chrono::milliseconds(config_.service.replica.lease_duration_ms);
+  const auto poll = std::chrono::milliseconds(10);
+  while (!stopping_ && Clock::now() - t0 < lease) {
+    std::this_thread::sleep_for(poll);
+    health_.beat();
+  }
+  const auto deadline = t0 + 4 * lease;
+  const dds::DataReader* readers[] = {dds_.replica_path_reader(), dds_.replica_status_reader()};
+  std::size_t others = 0;
+  bool matched = false;
+  while (!stopping_) {
+    // Every other replica's path and status writer, and this one's own, matched by both readers.
+    others = dds_.replicas().size();
+    matched = true;
+    for (const dds::DataReader* reader : readers) {
+      dds::SubscriptionMatchedStatus status;
+      reader->get_subscription_matched_status(status);
+      matched = matched && static_cast<std::size_t>(status.current_count) >= others + 1;
+    }
+    if (matched || Clock::now() >= deadline) break;
+    std::this_thread::sleep_for(poll);
+    health_.beat();
+  }
+  // Their history (one path and one status per vehicle they serve) follows the match; Fast DDS
+  // 2.9 has no wait_for_historical_data (unsupported), so it is taken until none has come for half
+  // a lease.
+  auto last_sample = Clock::now();
+  while (!stopping_ && matched && Clock::now() < deadline && Clock::now() - last_sample < lease / 2) {
+    if (take_replica_samples() > 0) last_sample = Clock::now();
+    std::this_thread::sleep_for(poll);
+    health_.beat();
+  }
+  const std::size_t vehicles = shadows_->size();
+  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  if (matched) {
+    spdlog::info("replica: in step with {} other replica(s) after {:.0f} ms ({} vehicle(s) served by them)", others, ms,
+                 vehicles);
+  } else {
+    spdlog::warn("replica: serving after {:.0f} ms although the writers of the {} other replica(s) did not all match",
+                 ms, others);
   }
 }
 
@@ -339,6 +406,11 @@ void PulloutService::take_over_departed() {
       if (!snapshot) continue;
       restore(*snapshot, request_known ? std::vector<RequestIssue>{}
                                        : std::vector<RequestIssue>{{"request", "not seen by this replica"}});
+      if (snapshot->request_is_later) {
+        // As if the vehicle sent it now: a departed vehicle's path answers it, segment kept.
+        std::optional<PlanningJob> job = registry_.on_request(snapshot->request, {});
+        if (job) queue_->push(std::move(*job));
+      }
       ++taken;
     }
     spdlog::info("took over {} of the {} vehicle(s) of the replica that left, in {:.1f} ms", taken, vehicles.size(),

@@ -76,7 +76,11 @@ class PulloutService {
   void take_progress();
   // Replica mode: the other replicas' paths and statuses (shadows), and the vehicles of replicas
   // that left (taken over when this replica wins them).
-  void take_replica_samples();
+  // Returns how many samples were taken.
+  std::size_t take_replica_samples();
+  // Replica mode, at start: waits (bounded by a few leases) until the other replicas' paths and
+  // statuses are here, so that no vehicle they serve is planned afresh by this one.
+  void sync_with_replicas();
   void take_over_departed();
   bool serving(const std::string& vehicle_id) const;
   // Whether the sample's writer may speak for vehicle_id (DdsEdge::sender_may_act_for); logs a

@@ -48,6 +48,14 @@ bool ReplicaShadows::serves(const std::string& vehicle_id, const ParticipantId& 
   return rendezvous_winner(vehicle_id, live) == self;
 }
 
+bool ReplicaShadows::owner_left(const std::string& vehicle_id, const ParticipantId& self,
+                                const std::vector<ParticipantId>& others) const {
+  const auto it = shadows_.find(vehicle_id);
+  if (it == shadows_.end() || !it->second.owner) return false;
+  const ParticipantId& owner = *it->second.owner;
+  return owner != self && std::find(others.begin(), others.end(), owner) == others.end();
+}
+
 ReplicaShadows::Shadow* ReplicaShadows::at(const std::string& vehicle_id) {
   const auto it = shadows_.find(vehicle_id);
   if (it != shadows_.end()) return &it->second;
@@ -87,6 +95,15 @@ std::optional<SessionSnapshot> ReplicaShadows::snapshot(const std::string& vehic
   const auto r = s.requests.find(s.status->request_id);
   if (r != s.requests.end()) {
     snap.request = r->second;
+    request_known = true;
+  } else if (!s.requests.empty()) {
+    // The owner left before its answer to the vehicle's latest request reached this replica:
+    // that request (the newest kept) gives the world, and is handled again after the restore.
+    const auto newest = std::max_element(s.requests.begin(), s.requests.end(), [](const auto& a, const auto& b) {
+      return a.second.stamp_ns < b.second.stamp_ns;
+    });
+    snap.request = newest->second;
+    snap.request_is_later = true;
     request_known = true;
   }
   return snap;

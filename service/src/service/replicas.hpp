@@ -51,13 +51,19 @@ class ReplicaShadows {
   // Whether this replica (`self`, with the other live replicas `others`) serves the vehicle now.
   bool serves(const std::string& vehicle_id, const ParticipantId& self, const std::vector<ParticipantId>& others) const;
 
+  // Whether the vehicle's owner has left (not `self`, not among `others`) and its vehicles are
+  // not taken over yet: its requests are kept for the takeover, not served as new ones.
+  bool owner_left(const std::string& vehicle_id, const ParticipantId& self,
+                  const std::vector<ParticipantId>& others) const;
+
   // Null when full.
   Shadow* at(const std::string& vehicle_id);
   void keep_request(const PullOutRequest& request);
   void erase(const std::string& vehicle_id) { shadows_.erase(vehicle_id); }
   // The vehicles whose owner is `departed`.
   std::vector<std::string> owned_by(const ParticipantId& departed) const;
-  // The snapshot to restore from (the request the status answers, when seen).
+  // The snapshot to restore from: the request the status answers when seen, else the newest kept
+  // request (request_is_later), else no request (request_known false).
   std::optional<SessionSnapshot> snapshot(const std::string& vehicle_id, bool& request_known) const;
   std::size_t size() const { return shadows_.size(); }
 

@@ -287,6 +287,10 @@ class PULLOUT_CLIENT_EXPORT Client {
   // usually takes tens of milliseconds but can take a few seconds (lost announcements are repeated
   // periodically): allow several seconds.
   bool wait_for_service(Duration timeout) const;
+  // How many services (each replica counts) read this client's requests now: the request
+  // writer's matched readers. A request sent while a replica is not among them never reaches
+  // that replica (the request topic is volatile).
+  std::size_t matched_services() const;
 
   const std::string& vehicle_id() const;
   int domain_id() const;

@@ -110,6 +110,10 @@ struct SessionSnapshot {
   PullOutRequest request;
   std::optional<PullOutPath> path;  // the path last published for it (found or not)
   PullOutStatus status;             // the status last published
+  // `request` is a later request of the vehicle than the one status answers (a replica that took
+  // the vehicle over saw the re-sent request but not the status that answered it): its lanes and
+  // objects serve the safety check, and the caller hands it to on_request after the restore.
+  bool request_is_later{false};
 };
 
 class VehicleSession {
