@@ -146,6 +146,36 @@ struct Matches {
   std::uint64_t request_epoch{0};  // incremented whenever the request writer matched a new reader
 };
 
+// One set of a vehicle's DDS endpoints: a ClientParticipant's shared set (Hub) or a Client's own.
+struct __attribute__((visibility("hidden"))) Endpoints {
+  dds::Publisher* publisher{nullptr};
+  dds::Subscriber* subscriber{nullptr};
+  dds::DataWriter* request_writer{nullptr};
+  dds::DataWriter* progress_writer{nullptr};
+  dds::ContentFilteredTopic* path_filter{nullptr};
+  dds::ContentFilteredTopic* status_filter{nullptr};
+  dds::DataReader* path_reader{nullptr};
+  dds::DataReader* status_reader{nullptr};
+
+  // Deletes what was created (each reader before its filter and subscriber, each writer before
+  // its publisher) and forgets it.
+  void destroy(dds::DomainParticipant& participant) noexcept {
+    if (subscriber != nullptr) {
+      if (path_reader != nullptr) subscriber->delete_datareader(path_reader);
+      if (status_reader != nullptr) subscriber->delete_datareader(status_reader);
+      participant.delete_subscriber(subscriber);
+    }
+    if (path_filter != nullptr) participant.delete_contentfilteredtopic(path_filter);
+    if (status_filter != nullptr) participant.delete_contentfilteredtopic(status_filter);
+    if (publisher != nullptr) {
+      if (request_writer != nullptr) publisher->delete_datawriter(request_writer);
+      if (progress_writer != nullptr) publisher->delete_datawriter(progress_writer);
+      participant.delete_publisher(publisher);
+    }
+    *this = Endpoints{};
+  }
+};
+
 class Hub;
 
 // The DDS participant, its topics and the vehicle filter factory, shared by the Clients on it: one
@@ -249,14 +279,7 @@ class __attribute__((visibility("hidden"))) Hub {
   dds::Topic* const path_topic_;
   dds::Topic* const status_topic_;
   const std::string profiles_file_;
-  dds::Publisher* publisher_{nullptr};
-  dds::Subscriber* subscriber_{nullptr};
-  dds::DataWriter* request_writer_{nullptr};
-  dds::DataWriter* progress_writer_{nullptr};
-  dds::ContentFilteredTopic* path_filter_{nullptr};
-  dds::ContentFilteredTopic* status_filter_{nullptr};
-  dds::DataReader* path_reader_{nullptr};
-  dds::DataReader* status_reader_{nullptr};
+  Endpoints ep_;  // the shared ones
 
   // The set: members_ as wanted, applied_ as the readers' filters have it. Guarded by set_mutex_.
   mutable std::mutex set_mutex_;
@@ -360,14 +383,7 @@ class __attribute__((visibility("hidden"))) Client::Impl final : public client_d
   bool claimed_{false};  // shared_ has this vehicle registered
   std::uint64_t serial_{0};
   dds::DomainParticipant* participant_{nullptr};
-  dds::ContentFilteredTopic* path_filter_{nullptr};
-  dds::ContentFilteredTopic* status_filter_{nullptr};
-  dds::Publisher* publisher_{nullptr};
-  dds::Subscriber* subscriber_{nullptr};
-  dds::DataWriter* request_writer_{nullptr};
-  dds::DataWriter* progress_writer_{nullptr};
-  dds::DataReader* path_reader_{nullptr};
-  dds::DataReader* status_reader_{nullptr};
+  client_detail::Endpoints ep_;  // its own (none when hub_ carries it)
   // The participant's shared endpoints carry this client (instead of the endpoints above); null
   // when it has its own.
   client_detail::Hub* hub_{nullptr};
@@ -562,16 +578,17 @@ Hub::~Hub() {
 }
 
 void Hub::create() {
-  publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
-  subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
-  if (publisher_ == nullptr || subscriber_ == nullptr) throw ClientError("cannot create a DDS publisher/subscriber");
+  ep_.publisher = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  ep_.subscriber = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (ep_.publisher == nullptr || ep_.subscriber == nullptr)
+    throw ClientError("cannot create a DDS publisher/subscriber");
   // The QoS of the per-Client endpoints (profile, else built in), with room for every vehicle's
   // instance: Fast DDS's default max_instances is 10.
   const auto writer_qos = [&](const char* profile) {
     dds::DataWriterQos qos = command_writer_qos();
     if (!profiles_file_.empty()) {
       dds::DataWriterQos from_profile;
-      if (publisher_->get_datawriter_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
+      if (ep_.publisher->get_datawriter_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
         qos = from_profile;
       }
     }
@@ -584,12 +601,12 @@ void Hub::create() {
     }
     return qos;
   };
-  request_writer_ = publisher_->create_datawriter(request_topic_, writer_qos(kRequestWriterProfile));
-  if (request_writer_ == nullptr) throw ClientError("cannot create the shared pullout/request writer");
-  progress_writer_ = publisher_->create_datawriter(progress_topic_, writer_qos(kProgressWriterProfile));
-  if (progress_writer_ == nullptr) throw ClientError("cannot create the shared pullout/progress writer");
-  request_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
-  progress_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
+  ep_.request_writer = ep_.publisher->create_datawriter(request_topic_, writer_qos(kRequestWriterProfile));
+  if (ep_.request_writer == nullptr) throw ClientError("cannot create the shared pullout/request writer");
+  ep_.progress_writer = ep_.publisher->create_datawriter(progress_topic_, writer_qos(kProgressWriterProfile));
+  if (ep_.progress_writer == nullptr) throw ClientError("cannot create the shared pullout/progress writer");
+  ep_.request_writer->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
+  ep_.progress_writer->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
 }
 
 // The readers are created with the first set, once Clients stopped coming for kApplyInterval: the
@@ -601,7 +618,7 @@ void Hub::create_readers(const std::vector<std::string>& parameters) {
     dds::DataReaderQos qos = reply_reader_qos(depth);
     if (!profiles_file_.empty()) {
       dds::DataReaderQos from_profile;
-      if (subscriber_->get_datareader_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
+      if (ep_.subscriber->get_datareader_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
         qos = from_profile;
       }
     }
@@ -620,35 +637,17 @@ void Hub::create_readers(const std::vector<std::string>& parameters) {
     *filter = participant_->create_contentfilteredtopic(name + "/vehicles", topic, idl::kVehicleSetFilterExpression,
                                                         parameters, idl::kVehicleFilterClass);
     if (*filter == nullptr) throw ClientError("cannot create the vehicle set filter on " + name);
-    dds::DataReader* reader = subscriber_->create_datareader(*filter, reader_qos(profile, depth));
+    dds::DataReader* reader = ep_.subscriber->create_datareader(*filter, reader_qos(profile, depth));
     if (reader == nullptr) throw ClientError("cannot create the shared " + name + " reader");
     reader->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
                                                        << dds::StatusMask::subscription_matched());
     return reader;
   };
-  path_reader_ = filtered_reader(path_topic_, kPathReaderProfile, kPathReaderDepth, &path_filter_);
-  status_reader_ = filtered_reader(status_topic_, kStatusReaderProfile, kStatusReaderDepth, &status_filter_);
+  ep_.path_reader = filtered_reader(path_topic_, kPathReaderProfile, kPathReaderDepth, &ep_.path_filter);
+  ep_.status_reader = filtered_reader(status_topic_, kStatusReaderProfile, kStatusReaderDepth, &ep_.status_filter);
 }
 
-void Hub::destroy() noexcept {
-  if (subscriber_ != nullptr) {
-    if (path_reader_ != nullptr) subscriber_->delete_datareader(path_reader_);
-    if (status_reader_ != nullptr) subscriber_->delete_datareader(status_reader_);
-    participant_->delete_subscriber(subscriber_);
-  }
-  if (path_filter_ != nullptr) participant_->delete_contentfilteredtopic(path_filter_);
-  if (status_filter_ != nullptr) participant_->delete_contentfilteredtopic(status_filter_);
-  if (publisher_ != nullptr) {
-    if (request_writer_ != nullptr) publisher_->delete_datawriter(request_writer_);
-    if (progress_writer_ != nullptr) publisher_->delete_datawriter(progress_writer_);
-    participant_->delete_publisher(publisher_);
-  }
-  subscriber_ = nullptr;
-  publisher_ = nullptr;
-  path_reader_ = status_reader_ = nullptr;
-  path_filter_ = status_filter_ = nullptr;
-  request_writer_ = progress_writer_ = nullptr;
-}
+void Hub::destroy() noexcept { ep_.destroy(*participant_); }
 
 bool Hub::add(const std::string& vehicle_id, VehicleSink* sink) {
   {
@@ -687,13 +686,13 @@ void Hub::remove(const std::string& vehicle_id, bool wrote_request, bool wrote_p
     msg::PullOutRequest key;
     key.vehicle_id(vehicle_id);
     std::lock_guard<std::mutex> lock(request_write_mutex_);
-    request_writer_->unregister_instance(&key, dds::HANDLE_NIL);
+    ep_.request_writer->unregister_instance(&key, dds::HANDLE_NIL);
   }
   if (wrote_progress) {
     msg::ExecutionProgress key;
     key.vehicle_id(vehicle_id);
     std::lock_guard<std::mutex> lock(progress_write_mutex_);
-    progress_writer_->unregister_instance(&key, dds::HANDLE_NIL);
+    ep_.progress_writer->unregister_instance(&key, dds::HANDLE_NIL);
   }
 }
 
@@ -714,18 +713,18 @@ std::size_t Hub::members() const {
 
 bool Hub::write_request(msg::PullOutRequest* sample) {
   std::lock_guard<std::mutex> lock(request_write_mutex_);
-  return request_writer_->write(sample);
+  return ep_.request_writer->write(sample);
 }
 
 bool Hub::write_progress(msg::ExecutionProgress* sample) {
   std::lock_guard<std::mutex> lock(progress_write_mutex_);
-  return progress_writer_->write(sample);
+  return ep_.progress_writer->write(sample);
 }
 
 void Hub::run() {
   dds::WaitSet waitset;
-  waitset.attach_condition(request_writer_->get_statuscondition());
-  waitset.attach_condition(progress_writer_->get_statuscondition());
+  waitset.attach_condition(ep_.request_writer->get_statuscondition());
+  waitset.attach_condition(ep_.progress_writer->get_statuscondition());
   waitset.attach_condition(wake_);
   dds::ConditionSeq active;
   SteadyClock::time_point last_apply{};
@@ -741,15 +740,15 @@ void Hub::run() {
     if (dirty) {
       // The first set once Clients stopped coming (create_readers), later ones at most every
       // kApplyInterval.
-      const auto due = path_reader_ == nullptr ? last_change + kApplyInterval : last_apply + kApplyInterval;
+      const auto due = ep_.path_reader == nullptr ? last_change + kApplyInterval : last_apply + kApplyInterval;
       const auto now = SteadyClock::now();
       if (due <= now) {
-        const bool first = path_reader_ == nullptr;
+        const bool first = ep_.path_reader == nullptr;
         apply_set();
         last_apply = now;
-        if (first && path_reader_ != nullptr) {
-          waitset.attach_condition(path_reader_->get_statuscondition());
-          waitset.attach_condition(status_reader_->get_statuscondition());
+        if (first && ep_.path_reader != nullptr) {
+          waitset.attach_condition(ep_.path_reader->get_statuscondition());
+          waitset.attach_condition(ep_.status_reader->get_statuscondition());
         }
       } else {
         wait = std::chrono::duration_cast<std::chrono::nanoseconds>(due - now);
@@ -765,11 +764,11 @@ void Hub::run() {
     wake_.set_trigger_value(false);
   }
   waitset.detach_condition(wake_);
-  waitset.detach_condition(progress_writer_->get_statuscondition());
-  waitset.detach_condition(request_writer_->get_statuscondition());
-  if (path_reader_ != nullptr) {
-    waitset.detach_condition(status_reader_->get_statuscondition());
-    waitset.detach_condition(path_reader_->get_statuscondition());
+  waitset.detach_condition(ep_.progress_writer->get_statuscondition());
+  waitset.detach_condition(ep_.request_writer->get_statuscondition());
+  if (ep_.path_reader != nullptr) {
+    waitset.detach_condition(ep_.status_reader->get_statuscondition());
+    waitset.detach_condition(ep_.path_reader->get_statuscondition());
   }
 }
 
@@ -783,23 +782,23 @@ void Hub::apply_set() {
   const std::vector<std::string> parameters = idl::encode_vehicle_set(ids);
   bool path_ok = false;
   bool status_ok = false;
-  if (path_reader_ == nullptr) {
+  if (ep_.path_reader == nullptr) {
     try {
       create_readers(parameters);
       path_ok = status_ok = true;
     } catch (const ClientError& e) {
       EPROSIMA_LOG_ERROR(PULLOUT_CLIENT, e.what());
       // Whatever was created goes; the next round tries again.
-      if (path_reader_ != nullptr) subscriber_->delete_datareader(path_reader_);
-      if (status_reader_ != nullptr) subscriber_->delete_datareader(status_reader_);
-      if (path_filter_ != nullptr) participant_->delete_contentfilteredtopic(path_filter_);
-      if (status_filter_ != nullptr) participant_->delete_contentfilteredtopic(status_filter_);
-      path_reader_ = status_reader_ = nullptr;
-      path_filter_ = status_filter_ = nullptr;
+      if (ep_.path_reader != nullptr) ep_.subscriber->delete_datareader(ep_.path_reader);
+      if (ep_.status_reader != nullptr) ep_.subscriber->delete_datareader(ep_.status_reader);
+      if (ep_.path_filter != nullptr) participant_->delete_contentfilteredtopic(ep_.path_filter);
+      if (ep_.status_filter != nullptr) participant_->delete_contentfilteredtopic(ep_.status_filter);
+      ep_.path_reader = ep_.status_reader = nullptr;
+      ep_.path_filter = ep_.status_filter = nullptr;
     }
   } else {
-    path_ok = path_filter_->set_expression_parameters(parameters) == ReturnCode::RETCODE_OK;
-    status_ok = status_filter_->set_expression_parameters(parameters) == ReturnCode::RETCODE_OK;
+    path_ok = ep_.path_filter->set_expression_parameters(parameters) == ReturnCode::RETCODE_OK;
+    status_ok = ep_.status_filter->set_expression_parameters(parameters) == ReturnCode::RETCODE_OK;
   }
   if (!path_ok || !status_ok) {
     // Cannot happen within kVehicleSetCapacityBytes; try again at the next round.
@@ -817,7 +816,7 @@ void Hub::apply_set() {
 }
 
 void Hub::take_and_route() {
-  if (path_reader_ == nullptr) return;
+  if (ep_.path_reader == nullptr) return;
   const auto route = [this](const std::string& vehicle_id, auto&& push) {
     std::lock_guard<std::mutex> lock(routes_mutex_);
     auto it = routes_.find(vehicle_id);
@@ -825,7 +824,7 @@ void Hub::take_and_route() {
   };
   msg::PullOutPath path_sample;
   dds::SampleInfo info;
-  while (path_reader_->take_next_sample(&path_sample, &info) == ReturnCode::RETCODE_OK) {
+  while (ep_.path_reader->take_next_sample(&path_sample, &info) == ReturnCode::RETCODE_OK) {
     if (!info.valid_data) continue;  // instance disposed / writer gone: nothing to deliver
     try {
       auto path = std::make_shared<const PullOutPath>(idl::from_msg(path_sample));
@@ -835,7 +834,7 @@ void Hub::take_and_route() {
     }
   }
   msg::PullOutStatus status_sample;
-  while (status_reader_->take_next_sample(&status_sample, &info) == ReturnCode::RETCODE_OK) {
+  while (ep_.status_reader->take_next_sample(&status_sample, &info) == ReturnCode::RETCODE_OK) {
     if (!info.valid_data) continue;
     try {
       auto status = std::make_shared<const PullOutStatus>(idl::from_msg(status_sample));
@@ -852,11 +851,11 @@ bool Hub::update_matches() {
   dds::SubscriptionMatchedStatus path_matched;
   dds::SubscriptionMatchedStatus status_matched;
   // This thread alone reads them (reading resets the change counts and the wait set trigger).
-  request_writer_->get_publication_matched_status(request_matched);
-  progress_writer_->get_publication_matched_status(progress_matched);
-  if (path_reader_ != nullptr) {
-    path_reader_->get_subscription_matched_status(path_matched);
-    status_reader_->get_subscription_matched_status(status_matched);
+  ep_.request_writer->get_publication_matched_status(request_matched);
+  ep_.progress_writer->get_publication_matched_status(progress_matched);
+  if (ep_.path_reader != nullptr) {
+    ep_.path_reader->get_subscription_matched_status(path_matched);
+    ep_.status_reader->get_subscription_matched_status(status_matched);
   }
   std::lock_guard<std::mutex> lock(matches_mutex_);
   const Matches before = matches_;
@@ -933,23 +932,27 @@ void Client::Impl::create_entities() {
     publisher_qos.partition().push_back(options_.vehicle_id.c_str());
     subscriber_qos.partition().push_back(options_.vehicle_id.c_str());
   }
-  publisher_ = participant_->create_publisher(publisher_qos);
-  subscriber_ = participant_->create_subscriber(subscriber_qos);
-  if (publisher_ == nullptr || subscriber_ == nullptr) throw ClientError("cannot create a DDS publisher/subscriber");
+  ep_.publisher = participant_->create_publisher(publisher_qos);
+  ep_.subscriber = participant_->create_subscriber(subscriber_qos);
+  if (ep_.publisher == nullptr || ep_.subscriber == nullptr)
+    throw ClientError("cannot create a DDS publisher/subscriber");
 
-  request_writer_ = publisher_->create_datawriter(request_topic, writer_qos(client_detail::kRequestWriterProfile));
-  if (request_writer_ == nullptr) throw ClientError("cannot create the pullout/request writer");
-  progress_writer_ = publisher_->create_datawriter(progress_topic, writer_qos(client_detail::kProgressWriterProfile));
-  if (progress_writer_ == nullptr) throw ClientError("cannot create the pullout/progress writer");
-  path_reader_ = create_reply_reader(path_topic, client_detail::kPathReaderProfile, kPathReaderDepth, &path_filter_);
-  status_reader_ =
-      create_reply_reader(status_topic, client_detail::kStatusReaderProfile, kStatusReaderDepth, &status_filter_);
-  path_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
-                                                           << dds::StatusMask::subscription_matched());
-  status_reader_->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
-                                                             << dds::StatusMask::subscription_matched());
-  request_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
-  progress_writer_->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
+  ep_.request_writer =
+      ep_.publisher->create_datawriter(request_topic, writer_qos(client_detail::kRequestWriterProfile));
+  if (ep_.request_writer == nullptr) throw ClientError("cannot create the pullout/request writer");
+  ep_.progress_writer =
+      ep_.publisher->create_datawriter(progress_topic, writer_qos(client_detail::kProgressWriterProfile));
+  if (ep_.progress_writer == nullptr) throw ClientError("cannot create the pullout/progress writer");
+  ep_.path_reader =
+      create_reply_reader(path_topic, client_detail::kPathReaderProfile, kPathReaderDepth, &ep_.path_filter);
+  ep_.status_reader =
+      create_reply_reader(status_topic, client_detail::kStatusReaderProfile, kStatusReaderDepth, &ep_.status_filter);
+  ep_.path_reader->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
+                                                              << dds::StatusMask::subscription_matched());
+  ep_.status_reader->get_statuscondition().set_enabled_statuses(dds::StatusMask::data_available()
+                                                                << dds::StatusMask::subscription_matched());
+  ep_.request_writer->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
+  ep_.progress_writer->get_statuscondition().set_enabled_statuses(dds::StatusMask::publication_matched());
 }
 
 dds::DataReader* Client::Impl::create_reply_reader(dds::Topic* topic, const char* profile, int depth,
@@ -961,7 +964,7 @@ dds::DataReader* Client::Impl::create_reply_reader(dds::Topic* topic, const char
       idl::kVehicleFilterClass);
   if (filtered == nullptr) throw ClientError("cannot create the vehicle filter on " + topic_name);
   *filter = filtered;
-  dds::DataReader* reader = subscriber_->create_datareader(filtered, reader_qos(profile, depth));
+  dds::DataReader* reader = ep_.subscriber->create_datareader(filtered, reader_qos(profile, depth));
   if (reader == nullptr) throw ClientError("cannot create the " + topic_name + " reader");
   return reader;
 }
@@ -970,7 +973,7 @@ dds::DataWriterQos Client::Impl::writer_qos(const char* profile) const {
   dds::DataWriterQos qos = client_detail::command_writer_qos();
   if (!options_.profiles_file.empty()) {
     dds::DataWriterQos from_profile;
-    if (publisher_->get_datawriter_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
+    if (ep_.publisher->get_datawriter_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
       qos = from_profile;
     }
   }
@@ -981,7 +984,7 @@ dds::DataReaderQos Client::Impl::reader_qos(const char* profile, int depth) cons
   dds::DataReaderQos qos = client_detail::reply_reader_qos(depth);
   if (!options_.profiles_file.empty()) {
     dds::DataReaderQos from_profile;
-    if (subscriber_->get_datareader_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
+    if (ep_.subscriber->get_datareader_qos_from_profile(profile, from_profile) == ReturnCode::RETCODE_OK) {
       qos = from_profile;
     }
   }
@@ -998,24 +1001,8 @@ void Client::Impl::destroy_entities() noexcept {
     // Only this client's entities: the other clients on the participant keep theirs. Readers
     // before their content-filtered topics.
     std::lock_guard<std::mutex> lock(shared_->entities_mutex());
-    if (subscriber_ != nullptr) {
-      if (path_reader_ != nullptr) subscriber_->delete_datareader(path_reader_);
-      if (status_reader_ != nullptr) subscriber_->delete_datareader(status_reader_);
-      participant_->delete_subscriber(subscriber_);
-    }
-    if (path_filter_ != nullptr) participant_->delete_contentfilteredtopic(path_filter_);
-    if (status_filter_ != nullptr) participant_->delete_contentfilteredtopic(status_filter_);
-    if (publisher_ != nullptr) {
-      if (request_writer_ != nullptr) publisher_->delete_datawriter(request_writer_);
-      if (progress_writer_ != nullptr) publisher_->delete_datawriter(progress_writer_);
-      participant_->delete_publisher(publisher_);
-    }
+    if (participant_ != nullptr) ep_.destroy(*participant_);
   }
-  publisher_ = nullptr;
-  subscriber_ = nullptr;
-  request_writer_ = progress_writer_ = nullptr;
-  path_reader_ = status_reader_ = nullptr;
-  path_filter_ = status_filter_ = nullptr;
   if (claimed_) shared_->release(options_.vehicle_id);
   claimed_ = false;
   participant_ = nullptr;
@@ -1122,10 +1109,10 @@ SteadyClock::time_point Client::Impl::update_service_and_resend() {
     dds::SubscriptionMatchedStatus path_matched;
     dds::SubscriptionMatchedStatus status_matched;
     // Reading a status also resets its trigger in the wait set.
-    request_writer_->get_publication_matched_status(request_matched);
-    progress_writer_->get_publication_matched_status(progress_matched);
-    path_reader_->get_subscription_matched_status(path_matched);
-    status_reader_->get_subscription_matched_status(status_matched);
+    ep_.request_writer->get_publication_matched_status(request_matched);
+    ep_.progress_writer->get_publication_matched_status(progress_matched);
+    ep_.path_reader->get_subscription_matched_status(path_matched);
+    ep_.status_reader->get_subscription_matched_status(status_matched);
     m.request = request_matched.current_count;
     m.progress = progress_matched.current_count;
     m.path = path_matched.current_count;
@@ -1175,12 +1162,12 @@ void Client::Impl::report_progress(ExecutionProgress progress) {
   if (progress.stamp_ns == 0) progress.stamp_ns = system_now_ns();
   msg::ExecutionProgress sample = idl::to_msg(progress);
   wrote_progress_.store(true);  // before the write: a destroyed client unregisters the instance
-  const bool written = hub_ != nullptr ? hub_->write_progress(&sample) : progress_writer_->write(&sample);
+  const bool written = hub_ != nullptr ? hub_->write_progress(&sample) : ep_.progress_writer->write(&sample);
   if (!written) throw ClientError("cannot write progress for request " + std::to_string(progress.request_id));
 }
 
 bool Client::Impl::write_request(msg::PullOutRequest* sample) {
-  if (hub_ == nullptr) return request_writer_->write(sample);
+  if (hub_ == nullptr) return ep_.request_writer->write(sample);
   wrote_request_.store(true);  // before the write: a destroyed client unregisters the instance
   return hub_->write_request(sample);
 }
@@ -1233,10 +1220,10 @@ void Client::Impl::run() {
   // With shared endpoints, the Hub wakes this thread (replies, matches).
   const bool own = hub_ == nullptr;
   if (own) {
-    waitset.attach_condition(path_reader_->get_statuscondition());
-    waitset.attach_condition(status_reader_->get_statuscondition());
-    waitset.attach_condition(request_writer_->get_statuscondition());
-    waitset.attach_condition(progress_writer_->get_statuscondition());
+    waitset.attach_condition(ep_.path_reader->get_statuscondition());
+    waitset.attach_condition(ep_.status_reader->get_statuscondition());
+    waitset.attach_condition(ep_.request_writer->get_statuscondition());
+    waitset.attach_condition(ep_.progress_writer->get_statuscondition());
   }
   waitset.attach_condition(wake_);
   dds::ConditionSeq active;
@@ -1255,10 +1242,10 @@ void Client::Impl::run() {
   }
   waitset.detach_condition(wake_);
   if (own) {
-    waitset.detach_condition(progress_writer_->get_statuscondition());
-    waitset.detach_condition(request_writer_->get_statuscondition());
-    waitset.detach_condition(status_reader_->get_statuscondition());
-    waitset.detach_condition(path_reader_->get_statuscondition());
+    waitset.detach_condition(ep_.progress_writer->get_statuscondition());
+    waitset.detach_condition(ep_.request_writer->get_statuscondition());
+    waitset.detach_condition(ep_.status_reader->get_statuscondition());
+    waitset.detach_condition(ep_.path_reader->get_statuscondition());
   }
 }
 
@@ -1271,7 +1258,7 @@ std::vector<std::shared_ptr<const PullOutPath>> Client::Impl::take_paths() {
   }
   msg::PullOutPath sample;
   dds::SampleInfo info;
-  while (path_reader_->take_next_sample(&sample, &info) == ReturnCode::RETCODE_OK) {
+  while (ep_.path_reader->take_next_sample(&sample, &info) == ReturnCode::RETCODE_OK) {
     if (!info.valid_data) continue;  // instance disposed / writer gone: nothing to deliver
     try {
       auto path = std::make_shared<PullOutPath>(idl::from_msg(sample));
@@ -1293,7 +1280,7 @@ std::vector<std::shared_ptr<const PullOutStatus>> Client::Impl::take_statuses() 
   }
   msg::PullOutStatus sample;
   dds::SampleInfo info;
-  while (status_reader_->take_next_sample(&sample, &info) == ReturnCode::RETCODE_OK) {
+  while (ep_.status_reader->take_next_sample(&sample, &info) == ReturnCode::RETCODE_OK) {
     if (!info.valid_data) continue;
     try {
       auto status = std::make_shared<PullOutStatus>(idl::from_msg(sample));
