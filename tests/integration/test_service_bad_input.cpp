@@ -170,7 +170,7 @@ std::size_t resident_bytes(pid_t pid) {
 
 TEST_F(BadInput, ARequestOverTheReadersPayloadSizeIsDroppedBeforeItIsReceivedWhole) {
   // The request reader's PREALLOCATED memory policy (config/dds/*.xml) fixes its payload size at
-  // the type's maximum serialized size (57,216,220 bytes): Fast DDS refuses a larger sample at its
+  // the type's maximum serialized size (59,963,736 bytes): Fast DDS refuses a larger sample at its
   // first fragment and acknowledges it as irrelevant, so the service never holds it. Before
   // (PREALLOCATED_WITH_REALLOC) the reader grew a payload to the sample's size and took it whole.
   start_service();
