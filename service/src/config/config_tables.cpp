@@ -430,6 +430,8 @@ const Table<ServiceConfig>& service_table() {
       field("log_level", &T::log_level, "", Choices{{kLogLevels.begin(), kLogLevels.end()}}, ""),
       field("progress_timeout_s", &T::progress_timeout_s, "s", in(0.0, 60.0),
             "a departed vehicle silent this long is told to stop (odometry lost); 0 = never"),
+      field("fleet_clearance_m", &T::fleet_clearance_m, "m", in(0.0, 5.0),
+            "vehicles that see each other: margin around the ego when checked against another's path"),
       note<T>("Vehicle sessions. A session is evicted (its path and status instances unregistered on the\n"
               "DDS writers, one log line) when it is idle, that is no search running and not driving a path\n"
               "(departed, not completed), and either its vehicle's request and progress writers are gone or\n"

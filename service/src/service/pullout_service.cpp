@@ -49,6 +49,7 @@ const char* outcome_name(PlanningResult::Outcome o) {
 RegistryOptions registry_options(const ServiceConfig& service, ServiceMetrics* metrics) {
   RegistryOptions o;
   o.session.progress_timeout_s = service.progress_timeout_s;
+  o.session.fleet_clearance_m = service.fleet_clearance_m;
   o.session_idle_timeout_s = service.session_idle_timeout_s;
   o.max_vehicles = service.max_vehicles;
   if (metrics != nullptr) {

@@ -68,6 +68,9 @@ struct ServiceConfig {
   std::string log_level{"info"};  // one of kLogLevels
   // [s] A departed vehicle with no progress sample for this long is told to stop (0: never).
   double progress_timeout_s{2.0};
+  // [m] Vehicles that see each other: the ego's footprint is pushed out this much on each side
+  // when its path is checked against another vehicle's executing path.
+  double fleet_clearance_m{0.5};
   // [s] A session with no request and no progress for this long, no search running and not
   // driving a path (departed and not completed), is evicted (0: never by time).
   double session_idle_timeout_s{300.0};
