@@ -34,10 +34,10 @@
 // service.replica.enabled (N = 1: one replica-mode service; 0, the default: the plain service).
 // Every service (plain too, unless --config is given) runs with its metrics on a port of its own;
 // once every replica is past its start-up sync (kReplicaSync after it was ready) and every client
-// matched all N services (Client::matched_services), the run starts. Reported per service: CPU over the send window,
-// peak RSS, replies published (pullout_replies_total) and vehicle sessions held (pullout_vehicles) at the end of the
-// window: how the vehicles were spread. The replies of all services add up to the requests answered when each request
-// was answered once.
+// matched all N services (Client::matched_services), the run starts. Reported per service: CPU
+// over the send window, peak RSS, vehicle sessions held in mid-window (pullout_vehicles) and
+// replies published after the drain (pullout_replies_total): how the vehicles were spread. The
+// replies of all services add up to the requests answered when each request was answered once.
 //
 // Bounded: matching kSetupTimeout, then duration + kDrain; the workers and the service are
 // stopped by PID (SIGTERM, then SIGKILL) on exit, on SIGINT/SIGTERM and on failure, and any
@@ -569,18 +569,17 @@ int run_coordinator(const Options& o) {
   const auto machine0 = machine_jiffies();
   const std::uint64_t drops0 = udp_rcvbuf_errors();
   const std::int64_t end_ns = start_ns + static_cast<std::int64_t>(o.duration * 1e9);
+  // Per service: vehicle sessions held in mid-window (every vehicle has asked by then, and none
+  // has left: the first workers delete their clients before the window's end).
+  if (!sleep_until_ns(start_ns + (end_ns - start_ns) / 2)) throw std::runtime_error("stopped by a signal");
+  std::vector<double> vehicles_mid;
+  for (int r = 0; metrics && r < services_n; ++r) {
+    vehicles_mid.push_back(metric_sum(http_get(port_base + r, "/metrics"), "pullout_vehicles"));
+  }
   if (!sleep_until_ns(end_ns)) throw std::runtime_error("stopped by a signal");
   const std::uint64_t bytes1 = count_bytes ? lo_tx_bytes() : 0;
   std::vector<std::uint64_t> service1;
   for (auto& sp : services) service1.push_back(cpu_ticks(sp->pid()));
-  // Per service: replies published and vehicle sessions held at the end of the window.
-  std::vector<double> replies_at_end;
-  std::vector<double> vehicles_at_end;
-  for (int r = 0; metrics && r < services_n; ++r) {
-    const std::string text = http_get(port_base + r, "/metrics");
-    replies_at_end.push_back(metric_sum(text, "pullout_replies_total"));
-    vehicles_at_end.push_back(metric_sum(text, "pullout_vehicles"));
-  }
   std::uint64_t workers1 = 0;
   for (auto& w : workers) workers1 += cpu_ticks(w->pid());
   const auto machine1 = machine_jiffies();
@@ -669,7 +668,7 @@ int run_coordinator(const Options& o) {
     std::snprintf(buf, sizeof(buf), "%s%.1f", sep, hwm_mb[r]);
     hwm_text += buf;
     if (metrics) {
-      std::snprintf(buf, sizeof(buf), "%s%.0f (%.0f)", sep, vehicles_at_end[r], replies_after_drain[r]);
+      std::snprintf(buf, sizeof(buf), "%s%.0f (%.0f)", sep, vehicles_mid[r], replies_after_drain[r]);
       spread_text += buf;
       replies_sum += replies_after_drain[r];
     }
