@@ -3,7 +3,7 @@
 //
 //   bench_load [--vehicles 1000] [--processes 4] [--rate 1] [--duration 30]
 //              [--participant-per-vehicle | --endpoints-per-client] [--no-netns] [--service PATH]
-//              [--config FILE]
+//              [--config FILE] [--replicas N]
 //
 // On a DDS domain leased for the run: the real pullout_service (config/pullout.yaml with
 // config/dds/loopback.xml) and `processes` worker processes (this binary with --worker), each
@@ -30,10 +30,22 @@
 // tx_bytes counts only this run: bytes per request = (window bytes - idle rate x window) / sent.
 // Without root (or with --no-netns) that figure is n/a.
 //
+// --replicas N (N >= 1): the service as N pullout_service processes on the domain, each with
+// service.replica.enabled (N = 1: one replica-mode service; 0, the default: the plain service).
+// Every service (plain too, unless --config is given) runs with its metrics on a port of its own;
+// once every replica is past its start-up sync (kReplicaSync after it was ready) and every client
+// matched all N services (Client::matched_services), the run starts. Reported per service: CPU
+// over the send window, peak RSS, vehicle sessions held in mid-window (pullout_vehicles) and
+// replies published after the drain (pullout_replies_total): how the vehicles were spread. The
+// replies of all services add up to the requests answered when each request was answered once.
+//
 // Bounded: matching kSetupTimeout, then duration + kDrain; the workers and the service are
 // stopped by PID (SIGTERM, then SIGKILL) on exit, on SIGINT/SIGTERM and on failure, and any
 // /dev/shm file this run left is removed. Prints one markdown row; results go to bench/RESULTS.md.
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -77,6 +89,7 @@ constexpr auto kSetupTimeout = 90s;                      // every worker's clien
 constexpr auto kDrain = 5s;                              // after the last send, for outstanding answers
 constexpr auto kIdleWindow = 2s;                         // idle loopback traffic, measured before the send window
 constexpr auto kStartMargin = 1s;                        // go -> first send
+constexpr auto kReplicaSync = 2500ms;                    // > a replica's start-up sync (4 leases of 500 ms)
 constexpr integration::Millis kWorkerStopTimeout{5000};  // SIGTERM -> SIGKILL
 
 std::atomic<bool> g_stop{false};
@@ -133,6 +146,7 @@ struct WorkerArgs {
   int first{0};  // global index of the first vehicle
   int count{0};
   int total{0};
+  int services{1};  // every client waits until its requests reach this many services
   double rate{1.0};
   double duration{10.0};
   bool participant_per_vehicle{false};
@@ -206,6 +220,14 @@ int run_worker(const WorkerArgs& a) {
     if (left <= 0s || !client->wait_for_service(left)) {
       std::fprintf(stderr, "worker %d: %s did not match the service\n", a.first, client->vehicle_id().c_str());
       return 3;
+    }
+    while (client->matched_services() < static_cast<std::size_t>(a.services)) {
+      if (g_stop.load() || SteadyClock::now() >= setup_deadline) {
+        std::fprintf(stderr, "worker %d: %s matched %zu of %d services\n", a.first, client->vehicle_id().c_str(),
+                     client->matched_services(), a.services);
+        return 3;
+      }
+      std::this_thread::sleep_for(10ms);
     }
   }
   note("clients matched");
@@ -370,6 +392,46 @@ std::uint64_t udp_rcvbuf_errors() {
   return 0;
 }
 
+// GET http://127.0.0.1:port/path (HTTP/1.0); the body, or "" on any failure (2 s timeouts).
+std::string http_get(int port, const std::string& path) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return "";
+  timeval timeout{2, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
+  ::setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &timeout, sizeof(timeout));
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string response;
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0) {
+    const std::string request = "GET " + path + " HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n";
+    if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size())) {
+      char buf[8192];
+      ssize_t n = 0;
+      while ((n = ::recv(fd, buf, sizeof(buf), 0)) > 0) response.append(buf, static_cast<std::size_t>(n));
+    }
+  }
+  ::close(fd);
+  const auto body = response.find("\r\n\r\n");
+  return body == std::string::npos ? "" : response.substr(body + 4);
+}
+
+// The sum of a metric's samples (every label set) in Prometheus text; -1 when absent.
+double metric_sum(const std::string& text, const std::string& name) {
+  std::istringstream lines(text);
+  std::string line;
+  double sum = -1.0;
+  while (std::getline(lines, line)) {
+    if (line.rfind(name, 0) != 0 || line.size() <= name.size()) continue;
+    const char next = line[name.size()];
+    if (next != ' ' && next != '{') continue;
+    const auto space = line.rfind(' ');
+    sum = std::max(sum, 0.0) + std::stod(line.substr(space + 1));
+  }
+  return sum;
+}
+
 using pullout::bench::load_text;
 
 struct Options {
@@ -381,6 +443,8 @@ struct Options {
   bool endpoints_per_client{false};
   bool no_netns{false};
   bool inside{false};
+  int replicas{0};  // 0: the plain service
+  bool config_given{false};
   std::string service_exe{PULLOUT_SERVICE_EXE};
   std::string config_path{source_path("config/pullout.yaml")};
 };
@@ -388,18 +452,39 @@ struct Options {
 int run_coordinator(const Options& o) {
   const bool count_bytes = o.inside;
   const std::set<std::string> shm_before = integration::list_dev_shm();
-  integration::ServiceOptions service_options;
-  service_options.executable = o.service_exe;
-  service_options.config_path = o.config_path;
-  integration::ServiceProcess service(service_options);
-  const pid_t service_pid = service.pid();
   integration::TempDir dir;
-  std::printf("bench_load: %d vehicles in %d processes (%s), %.2f Hz each, %.0f s; domain %d; load %s\n", o.vehicles,
-              o.processes,
+  // The services: one plain, or o.replicas in replica mode, each with its metrics port (unless
+  // --config: then as that file says, and no per-service counts).
+  const int services_n = std::max(1, o.replicas);
+  const bool metrics = !o.config_given;
+  const int port_base = 20000 + (::getpid() % 10000) * 4;
+  std::vector<std::unique_ptr<integration::ServiceProcess>> services;
+  for (int r = 0; r < services_n; ++r) {
+    integration::ServiceOptions service_options;
+    service_options.executable = o.service_exe;
+    service_options.config_path = o.config_path;
+    if (metrics) {
+      service_options.config_path = dir.write_file(
+          "service." + std::to_string(r) + ".yaml",
+          std::string(o.replicas > 0 ? "service:\n  replica:\n    enabled: true\n" : "") +
+              "observability:\n  metrics:\n    enabled: true\n    port: " + std::to_string(port_base + r) + "\n");
+    }
+    if (!services.empty()) service_options.domain = services.front()->domain();
+    services.push_back(std::make_unique<integration::ServiceProcess>(service_options));
+  }
+  integration::ServiceProcess& service = *services.front();
+  // Each replica past its start-up sync, which is bounded by four leases (default 500 ms; the
+  // bench sets no other): no metric tells it apart from a replica still syncing, and a request
+  // read meanwhile waits in the reader, so this only keeps the sync out of the send window.
+  if (o.replicas > 0) std::this_thread::sleep_for(kReplicaSync);
+  std::printf("bench_load: %d vehicles in %d processes (%s), %.2f Hz each, %.0f s; %s; domain %d; load %s\n",
+              o.vehicles, o.processes,
               o.participant_per_vehicle ? "one participant per vehicle"
               : o.endpoints_per_client  ? "shared participant, endpoints per client"
                                         : "shared participant and endpoints",
-              o.rate, o.duration, service.domain(), load_text().c_str());
+              o.rate, o.duration,
+              o.replicas == 0 ? "plain service" : (std::to_string(o.replicas) + " replica(s)").c_str(),
+              service.domain(), load_text().c_str());
   std::fflush(stdout);
 
   std::vector<std::unique_ptr<integration::ChildProcess>> workers;
@@ -425,6 +510,7 @@ int run_coordinator(const Options& o) {
                                   "--vehicles", std::to_string(o.vehicles),
                                   "--rate",     std::to_string(o.rate),
                                   "--duration", std::to_string(o.duration),
+                                  "--services", std::to_string(services_n),
                                   "--dir",      dir.path()};
     if (o.participant_per_vehicle) argv.push_back("--participant-per-vehicle");
     if (o.endpoints_per_client) argv.push_back("--endpoints-per-client");
@@ -476,15 +562,24 @@ int run_coordinator(const Options& o) {
   std::filesystem::rename(dir.path() + "/go.tmp", dir.path() + "/go");
   if (!sleep_until_ns(start_ns)) throw std::runtime_error("stopped by a signal");
   const std::uint64_t bytes0 = count_bytes ? lo_tx_bytes() : 0;
-  const std::uint64_t service0 = cpu_ticks(service_pid);
+  std::vector<std::uint64_t> service0;
+  for (auto& sp : services) service0.push_back(cpu_ticks(sp->pid()));
   std::uint64_t workers0 = 0;
   for (auto& w : workers) workers0 += cpu_ticks(w->pid());
   const auto machine0 = machine_jiffies();
   const std::uint64_t drops0 = udp_rcvbuf_errors();
   const std::int64_t end_ns = start_ns + static_cast<std::int64_t>(o.duration * 1e9);
+  // Per service: vehicle sessions held in mid-window (every vehicle has asked by then, and none
+  // has left: the first workers delete their clients before the window's end).
+  if (!sleep_until_ns(start_ns + (end_ns - start_ns) / 2)) throw std::runtime_error("stopped by a signal");
+  std::vector<double> vehicles_mid;
+  for (int r = 0; metrics && r < services_n; ++r) {
+    vehicles_mid.push_back(metric_sum(http_get(port_base + r, "/metrics"), "pullout_vehicles"));
+  }
   if (!sleep_until_ns(end_ns)) throw std::runtime_error("stopped by a signal");
   const std::uint64_t bytes1 = count_bytes ? lo_tx_bytes() : 0;
-  const std::uint64_t service1 = cpu_ticks(service_pid);
+  std::vector<std::uint64_t> service1;
+  for (auto& sp : services) service1.push_back(cpu_ticks(sp->pid()));
   std::uint64_t workers1 = 0;
   for (auto& w : workers) workers1 += cpu_ticks(w->pid());
   const auto machine1 = machine_jiffies();
@@ -508,7 +603,13 @@ int run_coordinator(const Options& o) {
   std::printf(
       "worker %d: %s", firsts.front(),
       integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts.front()) + ".out", 2000).c_str());
-  const double hwm_mb = vm_kb(service_pid, "VmHWM") / 1024.0;
+  std::vector<double> hwm_mb;
+  std::vector<double> replies_after_drain;
+  for (int r = 0; r < services_n; ++r) {
+    hwm_mb.push_back(vm_kb(services[r]->pid(), "VmHWM") / 1024.0);
+    if (metrics)
+      replies_after_drain.push_back(metric_sum(http_get(port_base + r, "/metrics"), "pullout_replies_total"));
+  }
   std::vector<double> latencies;
   std::vector<double> to_service_ms;    // send() -> the final status published
   std::vector<double> from_service_ms;  // published -> arrived
@@ -554,7 +655,25 @@ int run_coordinator(const Options& o) {
   }
   const pullout::bench::Summary s = pullout::bench::summarize(latencies);
   const double ticks = static_cast<double>(::sysconf(_SC_CLK_TCK));
-  const double service_cpu = 100.0 * static_cast<double>(service1 - service0) / ticks / o.duration;
+  std::string service_cpu_text;
+  std::string hwm_text;
+  std::string spread_text;
+  double replies_sum = 0.0;
+  for (int r = 0; r < services_n; ++r) {
+    const char* sep = r == 0 ? "" : " / ";
+    char buf[96];
+    std::snprintf(buf, sizeof(buf), "%s%.0f", sep,
+                  100.0 * static_cast<double>(service1[r] - service0[r]) / ticks / o.duration);
+    service_cpu_text += buf;
+    std::snprintf(buf, sizeof(buf), "%s%.1f", sep, hwm_mb[r]);
+    hwm_text += buf;
+    if (metrics) {
+      std::snprintf(buf, sizeof(buf), "%s%.0f (%.0f)", sep, vehicles_mid[r], replies_after_drain[r]);
+      spread_text += buf;
+      replies_sum += replies_after_drain[r];
+    }
+  }
+  if (!metrics) spread_text = "n/a";
   const double workers_cpu = 100.0 * static_cast<double>(workers1 - workers0) / ticks / o.duration;
   const double machine_busy = 100.0 * static_cast<double>(machine1.first - machine0.first) /
                               static_cast<double>(std::max<std::uint64_t>(1, machine1.second - machine0.second));
@@ -574,27 +693,39 @@ int run_coordinator(const Options& o) {
       count_bytes ? "" : " (host-wide)");
   const pullout::bench::Summary to = pullout::bench::summarize(to_service_ms);
   const pullout::bench::Summary from = pullout::bench::summarize(from_service_ms);
-  std::printf("send -> final status published: p50 %.2f p99 %.2f ms; published -> arrived: p50 %.2f p99 %.2f ms\n\n",
+  std::printf("send -> final status published: p50 %.2f p99 %.2f ms; published -> arrived: p50 %.2f p99 %.2f ms\n",
               to.p50, to.p99, from.p50, from.p99);
+  if (metrics) {
+    std::printf("replies published by the services after the drain: %.0f (requests answered: %zu)\n", replies_sum,
+                latencies.size());
+  }
+  std::printf("\n");
   std::printf(
-      "| vehicles | processes | participants | rate [Hz] | sent | replies/s | p50 [ms] | p99 [ms] | max [ms] | lost | "
-      "mismatched | not planned | service CPU [%% core] | service peak RSS [MB] | workers CPU [%% core] | machine busy "
-      "[%%] | bytes/request |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "| service | vehicles | processes | participants | rate [Hz] | sent | replies/s | p50 [ms] | p99 [ms] | max [ms] "
+      "| "
+      "lost | mismatched | not planned | service CPU [%% core] | service peak RSS [MB] | vehicles (replies) per "
+      "service | workers CPU [%% core] | machine busy [%%] | bytes/request |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::printf(
-      "| %d | %d | %s | %.2f | %zu | %.1f | %.2f | %.2f | %.2f | %zu | %d | %zu | %.0f | %.1f | %.0f | %.0f | %s |\n",
+      "| %s | %d | %d | %s | %.2f | %zu | %.1f | %.2f | %.2f | %.2f | %zu | %d | %zu | %s | %s | %s | %.0f | %.0f | %s "
+      "|\n",
+      o.replicas == 0 ? "plain" : (std::to_string(o.replicas) + (o.replicas == 1 ? " replica" : " replicas")).c_str(),
       o.vehicles, o.processes,
       o.participant_per_vehicle ? "1 per vehicle"
       : o.endpoints_per_client  ? "1 per process, endpoints per client"
                                 : "1 per process, shared endpoints",
       o.rate, sent, static_cast<double>(latencies.size()) / o.duration, s.p50, s.p99, s.max, lost, mismatched,
-      not_planned, service_cpu, hwm_mb, workers_cpu, machine_busy, bytes_text.c_str());
+      not_planned, service_cpu_text.c_str(), hwm_text.c_str(), spread_text.c_str(), workers_cpu, machine_busy,
+      bytes_text.c_str());
 
   for (auto& w : workers) {
     if (w->running()) ::kill(w->pid(), SIGTERM);
   }
   for (auto& w : workers) w->stop(kWorkerStopTimeout);
-  const integration::StopReport report = service.stop();
-  if (!report.clean()) std::printf("service stop: %s\n", report.describe().c_str());
+  for (std::size_t r = 0; r < services.size(); ++r) {
+    const integration::StopReport report = services[r]->stop();
+    if (!report.clean()) std::printf("service %zu stop: %s\n", r, report.describe().c_str());
+  }
   // Anything this run left in /dev/shm and no live process holds.
   const std::set<std::string> in_use = integration::dev_shm_files_in_use();
   for (const auto& name : integration::list_dev_shm()) {
@@ -657,14 +788,18 @@ int main(int argc, char** argv) {
                "each client with endpoints of its own on the shared participant (as before)");
   app.add_flag("--no-netns", o.no_netns, "do not use a network namespace (no byte count)");
   app.add_option("--service", o.service_exe, "the pullout_service binary");
-  app.add_option("--config", o.config_path, "the service's config");
+  app.add_option("--config", o.config_path, "the service's config (then no per-service counts)");
+  app.add_option("--replicas", o.replicas, "0: the plain service; N: N services in replica mode on the domain")
+      ->check(CLI::Range(0, 8));
   app.add_flag("--inside", o.inside, "(internal) inside the namespace");
   app.add_flag("--worker", worker, "(internal) a worker process");
   app.add_option("--domain", w.domain, "(internal)");
   app.add_option("--first", w.first, "(internal)");
   app.add_option("--count", w.count, "(internal)");
   app.add_option("--dir", w.dir, "(internal)");
+  app.add_option("--services", w.services, "(internal)");
   CLI11_PARSE(app, argc, argv);
+  o.config_given = app.count("--config") > 0;
   try {
     if (worker) {
       w.total = o.vehicles;
