@@ -208,8 +208,7 @@ std::vector<Pose2> manoeuvre_poses(const PullOutPath& path) {
   return poses;
 }
 
-Box manoeuvre_view(const PullOutRequest& request, const VehicleInfo& vehicle, const PullOutPath* path,
-                   double margin) {
+Box manoeuvre_view(const PullOutRequest& request, const VehicleInfo& vehicle, const PullOutPath* path, double margin) {
   Box core;
   core.add_all(vehicle_footprint(vehicle, request.ego_pose));
   if (path != nullptr && path->found) {

@@ -81,8 +81,7 @@ std::vector<Pose2> manoeuvre_poses(const PullOutPath& path);
 // at most kWholeObjectMaxM a side (a car, a truck: drawn whole; a larger polygon is cut at the
 // view's edge instead).
 constexpr double kWholeObjectMaxM = 15.0;
-Box manoeuvre_view(const PullOutRequest& request, const VehicleInfo& vehicle, const PullOutPath* path,
-                   double margin);
+Box manoeuvre_view(const PullOutRequest& request, const VehicleInfo& vehicle, const PullOutPath* path, double margin);
 
 // True when the partial path is driven in reverse (most of its points have a negative velocity).
 bool segment_is_reverse(const PathWithLaneId& segment);

@@ -106,14 +106,14 @@ TEST(ManoeuvreView, FramesTheFootprintsAndTheObjectsNextToThem) {
   close.width_m = 2.0;
   Object far = close;
   far.pose = {60.0, 3.0, 0.0};
-  Object huge = close;  // a 200 m wall along the road: cut at the view's edge, not framed whole
+  Object huge = close;           // a 200 m wall along the road: cut at the view's edge, not framed whole
   huge.pose = {10.0, 5.4, 0.0};  // y 4.9..5.9: meets the start's box (up to y 4.948)
   huge.length_m = 200.0;
   huge.width_m = 1.0;
   request.objects = {close, far, huge};
   const VehicleInfo vehicle;  // 1.1 m behind base_link, 3.79 m ahead, 0.948 m each side
   const Box start = manoeuvre_view(request, vehicle, nullptr, 1.0);
-  EXPECT_NEAR(start.min_x, 4.0, 1e-9);         // the close car's rear
+  EXPECT_NEAR(start.min_x, 4.0, 1e-9);  // the close car's rear
   EXPECT_NEAR(start.max_x, 10.0 + 3.79 + 1.0, 1e-9);
   EXPECT_NEAR(start.max_y, 3.0 + 0.948 + 1.0, 1e-9);  // the wall is not taken in whole
   EXPECT_NEAR(start.min_y, 3.0 - 0.948 - 1.0, 1e-9);  // below the close car's right side (y 2)
