@@ -11,10 +11,13 @@
 #include <stdexcept>
 
 #include "pullout/geometry/angle.hpp"
+#include "svg_draw.hpp"
 
 namespace pullout::cli {
 
 namespace {
+
+using namespace svg;  // the drawing primitives (svg_draw.hpp) are this file's vocabulary
 
 // --- style ---
 constexpr double kMarginPx = 20.0;
@@ -32,104 +35,6 @@ constexpr double kInsetMaxFraction = 0.4;
 constexpr double kInsetGapPx = 8.0;  // between the inset and the main view's edge
 constexpr double kLabelRadiusPx = 8.0;
 
-constexpr const char* kRoadFill = "#d9d9d9";
-constexpr const char* kShoulderFill = "#f2e2b3";
-constexpr const char* kLaneStroke = "#8c8c8c";
-constexpr const char* kRouteStroke = "#262626";
-constexpr const char* kObjectFill = "#ff7875";
-constexpr const char* kObjectStroke = "#a8071a";
-constexpr const char* kGridFill = "#7f7f7f";
-constexpr const char* kStartStroke = "#0050b3";
-constexpr const char* kEndStroke = "#237804";
-constexpr const char* kCuspStroke = "#7030a0";
-constexpr const char* kGoalStroke = "#000000";
-constexpr const char* kInsetViewStroke = "#cf1322";
-// Segment colours: distinct from the lane, object and footprint colours above.
-constexpr std::array<const char*, 8> kSegmentColours{"#fa8c16", "#722ed1", "#13c2c2", "#eb2f96",
-                                                     "#8c6d1f", "#2f54eb", "#7cb305", "#595959"};
-constexpr const char* kReverseDash = "8 4";
-
-const char* segment_colour(std::size_t i) { return kSegmentColours[i % kSegmentColours.size()]; }
-
-// World -> picture transform (y flipped so that it points up in the picture) of one view.
-struct Frame {
-  Box view;           // the world box shown [m]
-  double scale{1.0};  // [px/m]
-  double left{0.0};   // picture x of view.min_x [px]
-  double top{0.0};    // picture y of view.max_y [px]
-
-  double x(double wx) const { return left + (wx - view.min_x) * scale; }
-  double y(double wy) const { return top + (view.max_y - wy) * scale; }
-  double width_px() const { return view.width() * scale; }
-  double height_px() const { return view.height() * scale; }
-};
-
-std::string num(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.2f", v);
-  return buffer;
-}
-
-std::string length_label(double metres) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%g", metres);
-  return buffer;
-}
-
-std::string escape_xml(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        // Control characters are not allowed in XML 1.0 text.
-        if (static_cast<unsigned char>(c) >= 0x20 || c == '\t' || c == '\n') out += c;
-    }
-  }
-  return out;
-}
-
-template <typename Points>
-std::string points_attr(const Frame& f, const Points& points) {
-  std::string out;
-  for (const auto& p : points) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
-    if (!out.empty()) out += ' ';
-    out += num(f.x(p.x)) + ',' + num(f.y(p.y));
-  }
-  return out;
-}
-
-std::vector<Point2> lane_outline(const Lane& lane) {
-  std::vector<Point2> outline(lane.left_bound.begin(), lane.left_bound.end());
-  outline.insert(outline.end(), lane.right_bound.rbegin(), lane.right_bound.rend());
-  return outline;
-}
-
-std::vector<Point2> segment_points(const PathWithLaneId& segment) {
-  std::vector<Point2> points;
-  points.reserve(segment.points.size());
-  for (const auto& p : segment.points) points.push_back({p.pose.x, p.pose.y});
-  return points;
-}
-
-bool path_drawn(const PullOutPath* path) { return path != nullptr && path->found; }
-
 // Indices of the partial paths after which the vehicle stops to change direction.
 std::vector<std::size_t> cusp_segments(const PullOutPath* path) {
   std::vector<std::size_t> out;
@@ -141,15 +46,6 @@ std::vector<std::size_t> cusp_segments(const PullOutPath* path) {
     }
   }
   return out;
-}
-
-bool on_route(const PullOutRequest& request, const Lane& lane) {
-  const auto listed = [&lane](const std::vector<std::int64_t>& ids) {
-    return std::find(ids.begin(), ids.end(), lane.id) != ids.end();
-  };
-  return listed(request.route_lanelet_ids) ||
-         std::any_of(request.route_segments.begin(), request.route_segments.end(),
-                     [&](const RouteSegment& s) { return s.preferred_id == lane.id || listed(s.primitive_ids); });
 }
 
 // One run of occupied cells of a row of the request's grid (map frame corners).
@@ -243,43 +139,6 @@ std::vector<LegendEntry> legend_entries(const PullOutRequest& request, const Pul
          "inset: this view in the whole"});
   }
   return entries;
-}
-
-void draw_polyline(std::ostringstream& svg, const Frame& f, const std::vector<Point2>& polyline,
-                   const std::string& attributes, const std::string& last_extra = {});
-
-// A polygon clipped to the view; nothing when none of it is inside. `stroke` (its outline's
-// attributes) goes on the polygon when it is wholly inside; a polygon the view's edge cuts is
-// filled without an outline and its own edges are drawn (class "cut-outline"), so that the cut
-// does not look like an edge of the lane or object.
-void draw_polygon(std::ostringstream& svg, const Frame& f, const std::vector<Point2>& polygon,
-                  const std::string& attributes, const std::string& stroke) {
-  const std::vector<Point2> clipped = clip_polygon(polygon, f.view);
-  if (clipped.empty()) return;
-  const bool cut = !std::all_of(polygon.begin(), polygon.end(), [&](const Point2& p) {
-    return !std::isfinite(p.x) || !std::isfinite(p.y) || f.view.contains(p);
-  });
-  svg << "    <polygon " << attributes << ' ' << (cut ? std::string("stroke=\"none\"") : stroke) << " points=\""
-      << points_attr(f, clipped) << "\"/>\n";
-  if (cut && !stroke.empty()) {
-    std::vector<Point2> ring = polygon;
-    if (!ring.empty()) ring.push_back(ring.front());
-    draw_polyline(svg, f, ring, "class=\"cut-outline\" " + stroke);
-  }
-}
-
-// A polyline clipped to the view, one element per stretch inside; `last_extra` goes on the last.
-void draw_polyline(std::ostringstream& svg, const Frame& f, const std::vector<Point2>& polyline,
-                   const std::string& attributes, const std::string& last_extra) {
-  // Non-finite points are skipped (the line joins their neighbours), as everywhere in the picture.
-  std::vector<Point2> finite;
-  std::copy_if(polyline.begin(), polyline.end(), std::back_inserter(finite),
-               [](const Point2& p) { return std::isfinite(p.x) && std::isfinite(p.y); });
-  const auto runs = clip_polyline(finite, f.view);
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    svg << "    <polyline " << attributes << " points=\"" << points_attr(f, runs[k]) << "\" fill=\"none\""
-        << (k + 1 == runs.size() ? last_extra : std::string()) << "/>\n";
-  }
 }
 
 void draw_footprint(std::ostringstream& svg, const Frame& f, const VehicleInfo& vehicle, const Pose2& pose,
@@ -409,12 +268,6 @@ void draw_segments(std::ostringstream& svg, const Frame& f, const PullOutPath* p
         << l.index + 1 << "</text>\n";
   }
   svg << "  </g>\n";
-}
-
-void draw_goal(std::ostringstream& svg, const Frame& f, const Pose2& goal, const char* css_class, double radius_px) {
-  if (!std::isfinite(goal.x) || !std::isfinite(goal.y) || !f.view.contains(Point2{goal.x, goal.y})) return;
-  svg << "  <circle class=\"" << css_class << "\" cx=\"" << num(f.x(goal.x)) << "\" cy=\"" << num(f.y(goal.y))
-      << "\" r=\"" << num(radius_px) << "\" fill=\"none\" stroke=\"" << kGoalStroke << "\" stroke-width=\"1.5\"/>\n";
 }
 
 // The whole scene, small, in a corner of the main view, with the main view outlined.
