@@ -8,7 +8,6 @@ namespace pullout::cli::svg {
 
 const char* segment_colour(std::size_t i) { return kSegmentColours[i % kSegmentColours.size()]; }
 
-
 std::string num(double v) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%.2f", v);
@@ -48,7 +47,6 @@ std::string escape_xml(const std::string& text) {
   }
   return out;
 }
-
 
 std::vector<Point2> lane_outline(const Lane& lane) {
   std::vector<Point2> outline(lane.left_bound.begin(), lane.left_bound.end());

@@ -31,7 +31,7 @@ inline constexpr const char* kGoalStroke = "#000000";
 inline constexpr const char* kInsetViewStroke = "#cf1322";
 // Segment colours: distinct from the lane, object and footprint colours above.
 inline constexpr std::array<const char*, 8> kSegmentColours{"#fa8c16", "#722ed1", "#13c2c2", "#eb2f96",
-                                                     "#8c6d1f", "#2f54eb", "#7cb305", "#595959"};
+                                                            "#8c6d1f", "#2f54eb", "#7cb305", "#595959"};
 inline constexpr const char* kReverseDash = "8 4";
 
 const char* segment_colour(std::size_t i);

@@ -48,9 +48,15 @@ std::vector<std::size_t> cusp_segments(const PullOutPath* path) {
   return out;
 }
 
-// One run of occupied cells of a row of the request's grid (map frame corners).
+// The runs of occupied cells along each row of the request's grid (map frame corners).
+// A grid whose data does not fill width x height (a request the validation rejects, still drawn)
+// or without a positive resolution draws nothing. Occupied: unknown (< 0) or >= 50, as in ROS.
 std::vector<std::vector<Point2>> occupied_runs(const OccupancyGrid& g) {
   std::vector<std::vector<Point2>> runs;
+  if (g.data.size() < static_cast<std::size_t>(g.width) * g.height || !(g.resolution_m > 0.0) ||
+      !std::isfinite(g.resolution_m)) {
+    return runs;
+  }
   const double c = std::cos(g.origin.yaw);
   const double s = std::sin(g.origin.yaw);
   const auto at = [&](double u, double v) { return Point2{g.origin.x + c * u - s * v, g.origin.y + s * u + c * v}; };

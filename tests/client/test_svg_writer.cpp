@@ -229,6 +229,15 @@ TEST(RenderSvg, FreespaceShowsTheGridAndAFootprintAtEveryCusp) {
   parse(render_svg(request, VehicleInfo{}, &p, {}), plain);
   EXPECT_TRUE(with_class(plain, "grid-occupied").empty());
   EXPECT_TRUE(with_class(plain, "footprint-cusp").empty());
+  // A grid whose data is shorter than width x height (the request validation rejects it; the
+  // CLI still draws the request): no cell is read beyond the data, none is drawn.
+  OccupancyGrid short_grid = g;
+  short_grid.width = 400;
+  short_grid.height = 300;
+  request.occupancy_grid = short_grid;
+  Parsed bad;
+  parse(render_svg(request, VehicleInfo{}, &p, {}), bad);
+  EXPECT_TRUE(with_class(bad, "grid-occupied").empty());
 }
 
 }  // namespace
