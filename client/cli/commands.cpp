@@ -54,6 +54,7 @@ int emit(const PlanReport& report, const Scenario& scenario, const std::string& 
   }
   if (!options.svg_file.empty()) {
     SvgOptions svg;
+    svg.frame_manoeuvre = !options.svg_whole;
     svg.title = scenario_file + (report.found ? "  (" + std::string(to_string(report.planner)) + ")" : "  (no path)");
     if (scenario.map) {
       for (std::size_t i : scenario.map->lanelets_near({request.ego_pose.x, request.ego_pose.y}, kSvgMapRadius)) {

@@ -19,7 +19,8 @@ inline constexpr int kExitInterrupted = 130;
 
 struct OutputOptions {
   bool json{false};
-  std::string svg_file;  // empty: no SVG
+  std::string svg_file;   // empty: no SVG
+  bool svg_whole{false};  // the SVG's main view shows the whole scene (no manoeuvre framing, no inset)
 };
 
 struct PlanOptions {

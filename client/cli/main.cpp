@@ -38,7 +38,10 @@ int main(int argc, char** argv) {
   CLI::App* plan_cmd = app.add_subcommand("plan", "Plan in-process with the service's pipeline");
   plan_cmd->add_option("scenario", plan.scenario_file, "Scenario file (YAML)")->required()->check(CLI::ExistingFile);
   plan_cmd->add_flag("--json", plan.output.json, "Print one JSON object instead of text");
-  plan_cmd->add_option("--svg", plan.output.svg_file, "Also draw the scenario and path into this SVG file");
+  plan_cmd->add_option("--svg", plan.output.svg_file,
+                       "Also draw the scenario and path into this SVG file (framed on the manoeuvre, the whole "
+                       "scene in an inset)");
+  plan_cmd->add_flag("--svg-whole", plan.output.svg_whole, "The SVG shows the whole scene, no inset");
   plan_cmd->add_option("--config", plan.config_file, "pullout.yaml to start from (default: built-in defaults)")
       ->check(CLI::ExistingFile);
 
@@ -53,7 +56,10 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   request_cmd->add_flag("--json", request.output.json, "Print one JSON object instead of text");
-  request_cmd->add_option("--svg", request.output.svg_file, "Also draw the scenario and path into this SVG file");
+  request_cmd->add_option("--svg", request.output.svg_file,
+                          "Also draw the scenario and path into this SVG file (framed on the manoeuvre, the whole "
+                          "scene in an inset)");
+  request_cmd->add_flag("--svg-whole", request.output.svg_whole, "The SVG shows the whole scene, no inset");
   request_cmd->add_option("--domain", request.domain_id, "DDS domain id")
       ->capture_default_str()
       ->check(CLI::Range(0, 232));

@@ -3,11 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include <tinyxml2.h>
 #include <nlohmann/json.hpp>
 
 #include "pullout/config/scenario.hpp"
@@ -59,6 +63,82 @@ TEST(PlanText, SaysUnsafeForAFastCarFromBehind) {
   const CliRun run = run_cli("plan " + scenario_file("traffic_fast_from_behind"));
   EXPECT_EQ(run.exit_code, 0);
   EXPECT_NE(run.out.find("safe: no"), std::string::npos) << run.out;
+}
+
+// The picture of a pull-out from a tight spot: framed on the manoeuvre, the whole 100 m road in an
+// inset, one number per segment, a footprint at every change of direction.
+TEST(PlanSvg, FreespaceBoxedInIsFramedOnTheManoeuvre) {
+  const auto file =
+      std::filesystem::temp_directory_path() / ("pullout_test_cli_boxed_in_" + std::to_string(::getpid()) + ".svg");
+  const CliRun run = run_cli("plan " + scenario_file("freespace_boxed_in") + " --json --svg " + file.string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const auto json = nlohmann::json::parse(run.out);
+  ASSERT_EQ(json.at("planner"), "freespace");
+  const auto& segments = json.at("segments");
+  std::size_t changes = 0;
+  for (std::size_t i = 1; i < segments.size(); ++i) {
+    if (segments[i].at("direction") != segments[i - 1].at("direction")) ++changes;
+  }
+  ASSERT_GE(changes, 1u);  // the scenario wiggles out
+
+  tinyxml2::XMLDocument doc;
+  ASSERT_EQ(doc.LoadFile(file.c_str()), tinyxml2::XML_SUCCESS) << doc.ErrorStr();
+  std::filesystem::remove(file);
+  std::vector<const tinyxml2::XMLElement*> elements;
+  std::vector<const tinyxml2::XMLElement*> stack{doc.RootElement()};
+  while (!stack.empty()) {
+    const auto* e = stack.back();
+    stack.pop_back();
+    elements.push_back(e);
+    for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) stack.push_back(c);
+  }
+  const auto count = [&](const char* css_class) {
+    std::size_t n = 0;
+    for (const auto* e : elements) n += e->Attribute("class", css_class) != nullptr ? 1 : 0;
+    return n;
+  };
+  EXPECT_EQ(count("segment-label"), segments.size());
+  EXPECT_EQ(count("footprint-cusp"), changes);
+  EXPECT_EQ(count("inset-frame"), 1u);
+  EXPECT_EQ(count("inset-segment"), segments.size());
+  // The main view's width in metres, from the scale bar (its first line is the bar, its text the
+  // length): well under the 100 m road.
+  const tinyxml2::XMLElement* bar = nullptr;
+  const tinyxml2::XMLElement* frame = nullptr;
+  for (const auto* e : elements) {
+    if (e->Attribute("id", "scale-bar") != nullptr) bar = e;
+    if (e->Attribute("class", "frame") != nullptr) frame = e;
+  }
+  ASSERT_NE(bar, nullptr);
+  ASSERT_NE(frame, nullptr);
+  const auto* line = bar->FirstChildElement("line");
+  const double bar_px = line->DoubleAttribute("x2") - line->DoubleAttribute("x1");
+  const double bar_m = std::stod(bar->FirstChildElement("text")->GetText());
+  const double view_m = frame->DoubleAttribute("width") / (bar_px / bar_m);
+  EXPECT_LT(view_m, 50.0);
+  EXPECT_GT(view_m, 10.0);
+}
+
+TEST(PlanSvg, SvgWholeDrawsTheWholeSceneWithoutAnInset) {
+  const auto file =
+      std::filesystem::temp_directory_path() / ("pullout_test_cli_whole_" + std::to_string(::getpid()) + ".svg");
+  const CliRun run =
+      run_cli("plan " + scenario_file("freespace_boxed_in") + " --svg " + file.string() + " --svg-whole");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  tinyxml2::XMLDocument doc;
+  ASSERT_EQ(doc.LoadFile(file.c_str()), tinyxml2::XML_SUCCESS) << doc.ErrorStr();
+  std::filesystem::remove(file);
+  for (const auto* g = doc.RootElement()->FirstChildElement("g"); g != nullptr; g = g->NextSiblingElement("g")) {
+    EXPECT_EQ(g->Attribute("id", "inset"), nullptr);
+  }
+  // The road's outline (0..100 m) is drawn whole: one lane-road polygon with its stroke.
+  bool road = false;
+  for (const auto* g = doc.RootElement()->FirstChildElement("g"); g != nullptr; g = g->NextSiblingElement("g")) {
+    for (const auto* e = g->FirstChildElement("polygon"); e != nullptr; e = e->NextSiblingElement("polygon")) {
+      if (e->Attribute("class", "lane-road") != nullptr) road = e->Attribute("stroke", "none") == nullptr;
+    }
+  }
+  EXPECT_TRUE(road);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // The CLI's SVG writer: well-formed XML, one element per lane/object/segment, footprints from the
 // vehicle dimensions, y pointing up, a viewBox that holds everything, a legend and a scale bar.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,38 +14,13 @@
 #include <tinyxml2.h>
 
 #include "pullout/geometry/angle.hpp"
+#include "svg_test_support.hpp"
 #include "svg_writer.hpp"
 
 namespace pullout::cli {
 namespace {
 
-PullOutRequest scene() {
-  PullOutRequest request;
-  Lane road;
-  road.id = 1;
-  road.subtype = LaneSubtype::kRoad;
-  road.left_bound = {{0.0, 1.75}, {60.0, 1.75}};
-  road.right_bound = {{0.0, -1.75}, {60.0, -1.75}};
-  road.centerline = {{0.0, 0.0}, {60.0, 0.0}};
-  Lane shoulder;
-  shoulder.id = 2;
-  shoulder.subtype = LaneSubtype::kRoadShoulder;
-  shoulder.left_bound = {{0.0, 4.75}, {60.0, 4.75}};
-  shoulder.right_bound = {{0.0, 1.75}, {60.0, 1.75}};
-  request.lanes = {road, shoulder};
-  Object car;
-  car.id = 7;
-  car.object_class = ObjectClass::kCar;
-  car.pose = {20.0, 3.25, 0.0};
-  Object triangle;
-  triangle.id = 8;
-  triangle.pose = {40.0, -1.0, 0.0};
-  triangle.polygon = {{1.0, 0.0}, {-1.0, 1.0}, {-1.0, -1.0}};
-  request.objects = {car, triangle};
-  request.ego_pose = {10.0, 3.25, 0.0};
-  request.goal_pose = {55.0, 0.0, 0.0};
-  return request;
-}
+using namespace svg_testing;  // the picture-reading helpers (svg_test_support.hpp)
 
 PullOutPath path() {
   PullOutPath p;
@@ -59,55 +35,6 @@ PullOutPath path() {
   p.start_pose = {7.0, 3.25, 0.0};
   p.end_pose = {37.0, 0.25, 0.0};
   return p;
-}
-
-struct Parsed {
-  tinyxml2::XMLDocument doc;
-  const tinyxml2::XMLElement* root{nullptr};
-  std::vector<const tinyxml2::XMLElement*> elements;  // every element, depth first
-};
-
-void collect(const tinyxml2::XMLElement* e, std::vector<const tinyxml2::XMLElement*>& out) {
-  for (; e != nullptr; e = e->NextSiblingElement()) {
-    out.push_back(e);
-    collect(e->FirstChildElement(), out);
-  }
-}
-
-void parse(const std::string& svg, Parsed& parsed) {
-  ASSERT_EQ(parsed.doc.Parse(svg.c_str()), tinyxml2::XML_SUCCESS) << parsed.doc.ErrorStr() << "\n" << svg;
-  parsed.root = parsed.doc.RootElement();
-  ASSERT_NE(parsed.root, nullptr);
-  collect(parsed.root, parsed.elements);
-}
-
-std::vector<const tinyxml2::XMLElement*> with_class(const Parsed& p, const std::string& css_class) {
-  std::vector<const tinyxml2::XMLElement*> out;
-  for (const auto* e : p.elements) {
-    const char* c = e->Attribute("class");
-    if (c != nullptr && css_class == c) out.push_back(e);
-  }
-  return out;
-}
-
-std::vector<Point2> points_of(const tinyxml2::XMLElement* e) {
-  std::vector<Point2> out;
-  std::istringstream in(e->Attribute("points"));
-  std::string pair;
-  while (in >> pair) {
-    Point2 p;
-    EXPECT_EQ(std::sscanf(pair.c_str(), "%lf,%lf", &p.x, &p.y), 2) << pair;
-    out.push_back(p);
-  }
-  return out;
-}
-
-std::string all_text(const Parsed& p) {
-  std::string out;
-  for (const auto* e : p.elements) {
-    if (e->GetText() != nullptr) out += std::string(e->GetText()) + "\n";
-  }
-  return out;
 }
 
 TEST(VehicleFootprint, CornersFromVehicleInfo) {
@@ -152,7 +79,9 @@ TEST(RenderSvg, ElementsForEveryPart) {
   const PullOutRequest request = scene();
   const PullOutPath p = path();
   Parsed parsed;
-  parse(render_svg(request, VehicleInfo{}, &p, {1000.0, 800.0, "demo & test"}), parsed);
+  SvgOptions options;
+  options.title = "demo & test";
+  parse(render_svg(request, VehicleInfo{}, &p, options), parsed);
   EXPECT_STREQ(parsed.root->Name(), "svg");
   EXPECT_EQ(with_class(parsed, "lane-road").size(), 1u);
   EXPECT_EQ(with_class(parsed, "lane-shoulder").size(), 1u);
@@ -172,7 +101,7 @@ TEST(RenderSvg, ElementsForEveryPart) {
 
   const std::string text = all_text(parsed);
   for (const char* label : {"road lane", "road shoulder", "object", "vehicle at start", "vehicle at end",
-                            "segment 0 (reverse)", "segment 1 (forward)", "goal", "demo & test", " m"}) {
+                            "segment 1: reverse (dashed)", "segment 2: forward", "goal", "demo & test", " m"}) {
     EXPECT_NE(text.find(label), std::string::npos) << label << " in\n" << text;
   }
 }
@@ -180,7 +109,9 @@ TEST(RenderSvg, ElementsForEveryPart) {
 TEST(RenderSvg, YAxisPointsUpAndScaleIsUniform) {
   const PullOutRequest request = scene();
   Parsed parsed;
-  parse(render_svg(request, VehicleInfo{}, nullptr), parsed);
+  SvgOptions whole;  // the whole scene: lane outlines are not cut at a view's edge
+  whole.frame_manoeuvre = false;
+  parse(render_svg(request, VehicleInfo{}, nullptr, whole), parsed);
   // The shoulder (world y 1.75..4.75) is above the road (world y -1.75..1.75): smaller picture y.
   const auto road = points_of(with_class(parsed, "lane-road")[0]);
   const auto shoulder = points_of(with_class(parsed, "lane-shoulder")[0]);
@@ -248,6 +179,7 @@ TEST(SvgWriter, DrawsMapLaneletsAndOutlinesTheRoute) {
   for (auto& p : options.map_lanes.back().right_bound) p.x += 60.0;
   request.lanes.clear();
   request.route_lanelet_ids = {1, 3};
+  options.frame_manoeuvre = false;
   Parsed parsed;
   parse(render_svg(request, VehicleInfo{}, nullptr, options), parsed);
   EXPECT_EQ(with_class(parsed, "map-road route").size(), 2u);
@@ -259,12 +191,6 @@ TEST(SvgWriter, DrawsMapLaneletsAndOutlinesTheRoute) {
   const double width = std::stod(parsed.root->Attribute("width"));
   for (const Point2& p : far) EXPECT_LT(p.x, width);
 }
-
-}  // namespace
-}  // namespace pullout::cli
-
-namespace pullout::cli {
-namespace {
 
 TEST(RenderSvg, FreespaceShowsTheGridAndAFootprintAtEveryCusp) {
   // A 4 x 2 cell grid with two occupied runs (row 0: cells 1-2; row 1: cell 3 unknown) and a
@@ -292,7 +218,9 @@ TEST(RenderSvg, FreespaceShowsTheGridAndAFootprintAtEveryCusp) {
   parse(render_svg(request, VehicleInfo{}, &p, {}), parsed);
   EXPECT_EQ(with_class(parsed, "grid-occupied").size(), 2u);
   EXPECT_EQ(with_class(parsed, "footprint-cusp").size(), 2u);
-  EXPECT_EQ(with_class(parsed, "cusp-label").size(), 2u);
+  EXPECT_EQ(with_class(parsed, "segment-label").size(), 3u);
+  EXPECT_NE(all_text(parsed).find("vehicle at a cusp"), std::string::npos);
+  EXPECT_NE(all_text(parsed).find("occupied grid cell"), std::string::npos);
   // Without cusps (one direction) and without a grid: none.
   p.partial_paths.resize(1);
   p.pairs_terminal_velocity_and_accel.resize(1);
@@ -301,6 +229,15 @@ TEST(RenderSvg, FreespaceShowsTheGridAndAFootprintAtEveryCusp) {
   parse(render_svg(request, VehicleInfo{}, &p, {}), plain);
   EXPECT_TRUE(with_class(plain, "grid-occupied").empty());
   EXPECT_TRUE(with_class(plain, "footprint-cusp").empty());
+  // A grid whose data is shorter than width x height (the request validation rejects it; the
+  // CLI still draws the request): no cell is read beyond the data, none is drawn.
+  OccupancyGrid short_grid = g;
+  short_grid.width = 400;
+  short_grid.height = 300;
+  request.occupancy_grid = short_grid;
+  Parsed bad;
+  parse(render_svg(request, VehicleInfo{}, &p, {}), bad);
+  EXPECT_TRUE(with_class(bad, "grid-occupied").empty());
 }
 
 }  // namespace
