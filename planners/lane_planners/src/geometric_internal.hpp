@@ -31,8 +31,10 @@ inline double corner_swing(double r, double along, double across, double turn, d
 // The S candidates from `start` (see geometric_pull_out.hpp), tightest end pose first. With a
 // finite `usable_margin` [m] the search ends at the first candidate usable at that margin (no
 // rejection, clearance >= usable_margin); +inf: every candidate. With `turn_paths`, the arcs of
-// each candidate are appended to it (an empty path for a candidate with none).
+// each candidate are appended to it (an empty path for a candidate with none). With
+// `turn_candidates`, two turns at R_min joined by a 0..9 m tangent follow the S candidates.
 PlannerCandidates arc_pair_candidates(const PlanningContext& context, const Pose2& start, const StopCondition& stop,
-                                      double usable_margin, std::vector<CurvaturePath>* turn_paths);
+                                      double usable_margin, std::vector<CurvaturePath>* turn_paths,
+                                      bool turn_candidates);
 
 }  // namespace pullout

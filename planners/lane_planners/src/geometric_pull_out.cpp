@@ -83,7 +83,8 @@ double side_clearance(const LaneWorld& world, const Footprint& base, double Foot
 }  // namespace
 
 PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& start, const StopCondition& stop,
-                                      double usable_margin, std::vector<CurvaturePath>* turn_paths) {
+                                      double usable_margin, std::vector<CurvaturePath>* turn_paths,
+                                      bool turn_candidates) {
   // One path per candidate (empty for those with no geometry), when asked for.
   const auto keep = [turn_paths](const CurvaturePath& path) {
     if (turn_paths != nullptr) turn_paths->push_back(path);
@@ -151,15 +152,22 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
   const double q = r_first * r_first - (r_first - half_offset) * (r_first - half_offset);
   const double s_base = start_on_road.s + 2.0 * std::sqrt(std::max(q, 0.0));
 
-  for (int k = 0; k < kEndOffsets; ++k) {
+  // Tilted starts (a shunting manoeuvre's): after the S candidates, two turns at R_min joined by
+  // a tangent of 0..9 m (which may turn away from the road first: a counter-arc onto the lane).
+  const int rounds = turn_candidates ? 2 * kEndOffsets : kEndOffsets;
+  for (int round = 0; round < rounds; ++round) {
     out.stopped = stop.check();
     if (out.stopped != StopReason::kNone) break;
+    const bool tangent_round = round >= kEndOffsets;
+    const int k = tangent_round ? round - kEndOffsets : round;
     // An S of two arcs to the end pose on the centerline: the first arc at r_first, the second's
     // radius solved (Vorobieva). Where no S reaches it (a start across the road, out of a
     // perpendicular bay), two turns at R_min joined by a k m tangent.
     std::optional<TwoTurnPath> turns;
     const double s_end = s_base + k;
-    if (q >= 0.0 && s_end <= center.length()) turns = solve_arc_pair(start, center.pose_at(s_end), r_first, r_min);
+    if (!tangent_round && q >= 0.0 && s_end <= center.length()) {
+      turns = solve_arc_pair(start, center.pose_at(s_end), r_first, r_min);
+    }
     const bool arc_pair = turns.has_value();
     if (!arc_pair) turns = solve_two_turn(start, window, {kappa, 0.0, static_cast<double>(k)});
     if (!turns) {
@@ -240,7 +248,7 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
 
 PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2& start,
                                          const StopCondition& stop) const {
-  return arc_pair_candidates(ctx, start, stop, kInfinity, nullptr);
+  return arc_pair_candidates(ctx, start, stop, kInfinity, nullptr, false);
 }
 
 }  // namespace pullout

@@ -1,6 +1,9 @@
 // The geometric planner's shunting manoeuvre (see geometric_pull_out.hpp): moves at full lock,
 // alternating forward and reverse, each until just clear, then the S.
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include "pullout/model/names.hpp"
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -19,6 +22,9 @@ namespace {
 // [m] Added to the smallest collision margin where a move stops: the clearance between samples
 // can fall below a sampled one by at most (Lipschitz constant <= 1.6) x half the largest step.
 constexpr double kStopSlack = 0.02;
+// [m] Added to the smallest margin for the dense clearance of the S: between samples 1 cm apart
+// the clearance falls by at most 1.6 x 0.5 cm below them.
+constexpr double kDenseSlack = 0.01;
 constexpr double kMinStep = 0.02;  // [m] sampling of a move where the clearance is near the limit
 constexpr double kMaxStep = 0.1;   // [m] and where it is not (and of the lane check)
 constexpr int kEndBisections = 10;  // a bracket of 0.1 m shrinks to 0.1 mm
@@ -207,15 +213,22 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
     if (out.stopped != StopReason::kNone) return out;
     // 1. The S from here.
     std::vector<CurvaturePath> turn_paths;
-    PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, kInfinity, &turn_paths);
+    PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, kInfinity, &turn_paths, moves.size() > 1);
+    if (std::getenv("SHUNT_DEBUG") != nullptr) {
+      std::fprintf(stderr, "pose %.3f %.3f %.3f tilt %.3f\n", pose.x, pose.y, pose.yaw, tilt_at(pose));
+      for (const auto& c : s.candidates) {
+        std::fprintf(stderr, "   %s %s clr %.3f\n", c.rejection ? to_string(c.rejection->outcome) : "ok",
+                     c.rejection ? c.rejection->detail.c_str() : "", c.clearance);
+      }
+    }
     for (std::size_t i = 0; i < s.candidates.size(); ++i) {
       PathCandidate& c = s.candidates[i];
       if (c.rejection || c.clearance < ctx.smallest_margin) continue;
       // The S's own clearance samples every 0.5 m and refines around minima; from a tilted start
       // the corners pass the cars within centimetres of the start, so it is taken densely here.
       const CurvaturePath& turns = turn_paths[i];
-      const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kStopSlack);
-      if (dense.distance < ctx.smallest_margin + kStopSlack) continue;
+      const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kDenseSlack);
+      if (dense.distance < ctx.smallest_margin + kDenseSlack) continue;
       exit = std::move(c);
       break;
     }
@@ -233,7 +246,9 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
       stuck = "no room to move forward after " + std::to_string(shunt) + " shunts";
       break;
     }
-    if (!add(-side * kappa, -1.0, move_cap)) {
+    // Where the rear has reached the kerb at full lock, straight back still makes room ahead (it
+    // takes the rear corner towards the kerb less than a reverse arc up to about 60 degrees).
+    if (!add(-side * kappa, -1.0, move_cap) && !add(0.0, -1.0, move_cap)) {
       stuck = "no room to reverse after " + std::to_string(shunt) + " shunts and a forward move";
       break;
     }
@@ -245,14 +260,19 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
   candidate.clearance = exit->clearance;
   candidate.nearest_obstacle = exit->nearest_obstacle;
   for (const Move& m : moves) {
-    const auto c = dense_clearance(ctx, m.path(), m.length, ctx.smallest_margin);
+    const auto c = dense_clearance(ctx, m.path(), m.length, ctx.smallest_margin + kDenseSlack);
+    if (c.distance < ctx.smallest_margin + kDenseSlack) {
+      // Closer than the smallest margin allows somewhere (dense_clearance stopped there).
+      candidate.rejection = Failure{AttemptOutcome::kCollision, "object " + std::to_string(c.obstacle_id) +
+                                                                    " closer than the smallest margin on a move"};
+      candidate.clearance = c.distance;
+      candidate.nearest_obstacle = c.obstacle_id;
+      break;
+    }
     if (c.distance < candidate.clearance) {
       candidate.clearance = c.distance;
       candidate.nearest_obstacle = c.obstacle_id;
     }
-  }
-  if (candidate.clearance < 1e-6) {
-    candidate.rejection = Failure{AttemptOutcome::kCollision, "object " + std::to_string(candidate.nearest_obstacle)};
   }
   auto shared_moves = std::make_shared<const std::vector<Move>>(std::move(moves));
   candidate.build = [&ctx, shared_moves, exit_build = exit->build, start]() {
