@@ -224,8 +224,8 @@ int main(int argc, char** argv) {
                   t->cusps += direction_changes(r.path);
                   t->max_cusps = std::max(t->max_cusps, direction_changes(r.path));
                   t->stops += static_cast<int>(r.path.partial_paths.size()) - 1;
-                  const bool shunted = r.path.planner_type == PlannerType::kGeometric &&
-                                       !r.evaluation_table.empty() && r.evaluation_table.back().detail == "shunting";
+                  const bool shunted = r.path.planner_type == PlannerType::kGeometric && !r.evaluation_table.empty() &&
+                                       r.evaluation_table.back().detail == "shunting";
                   ++t->by_planner[std::string(to_string(r.path.planner_type)) + (shunted ? " (shunts)" : "")];
                 }
               }

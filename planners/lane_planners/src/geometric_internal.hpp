@@ -27,7 +27,6 @@ inline double corner_swing(double r, double along, double across, double turn, d
   return (turn >= peak - tilt ? radius : radius * std::cos(turn + tilt - peak)) - at_start;
 }
 
-
 // The S candidates from `start` (see geometric_pull_out.hpp), tightest end pose first. With a
 // finite `usable_margin` [m] the search ends at the first candidate usable at that margin (no
 // rejection, clearance >= usable_margin); +inf: every candidate. With `turn_paths`, the arcs of

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "geometric_internal.hpp"
 #include "pullout/collision/footprint.hpp"
 #include "pullout/geometry/angle.hpp"
-#include "geometric_internal.hpp"
 #include "pullout/lane_planners/two_turn_path.hpp"
 #include "turn_candidate.hpp"
 
@@ -109,8 +109,7 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
   const double side = start_on_road.lateral < 0.0 ? 1.0 : -1.0;  // +1: the road is to the left
   // How far the start is turned towards the road (0: parallel to it; a shunting manoeuvre's
   // later start poses). The lanes' edge on the kerb side runs along the road.
-  const double tilt =
-      std::max(0.0, side * normalize_angle(start.yaw - center.pose_at(start_on_road.s).yaw));
+  const double tilt = std::max(0.0, side * normalize_angle(start.yaw - center.pose_at(start_on_road.s).yaw));
   double Footprint::*const road_side = side > 0.0 ? &Footprint::left : &Footprint::right;
   double Footprint::*const kerb_side = side > 0.0 ? &Footprint::right : &Footprint::left;
   Footprint fp = plain;

@@ -1,9 +1,6 @@
 // The geometric planner's shunting manoeuvre (see geometric_pull_out.hpp): moves at full lock,
 // alternating forward and reverse, each until just clear, then the S.
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
-#include "pullout/model/names.hpp"
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -25,14 +22,15 @@ constexpr double kStopSlack = 0.02;
 // [m] Added to the smallest margin for the dense clearance of the S: between samples 1 cm apart
 // the clearance falls by at most 1.6 x 0.5 cm below them.
 constexpr double kDenseSlack = 0.01;
-constexpr double kMinStep = 0.02;  // [m] sampling of a move where the clearance is near the limit
-constexpr double kMaxStep = 0.1;   // [m] and where it is not (and of the lane check)
-constexpr int kEndBisections = 10;  // a bracket of 0.1 m shrinks to 0.1 mm
-constexpr double kMinMove = 0.01;   // [m] a move shorter than this is a dead end
+constexpr double kMinStep = 0.02;    // [m] sampling of a move where the clearance is near the limit
+constexpr double kMaxStep = 0.1;     // [m] and where it is not (and of the lane check)
+constexpr int kEndBisections = 10;   // a bracket of 0.1 m shrinks to 0.1 mm
+constexpr double kMinMove = 0.01;    // [m] a move shorter than this is a dead end
 constexpr double kLaneSlack = 0.01;  // [m] footprint growth of the moves' lane check
-// [rad] A move turns the vehicle by at most this; a start turned further from the road than
-// kMaxTilt is no parallel spot any more.
-constexpr double kMaxMoveTurn = kPi / 3.0;
+// [rad] A move turns the vehicle by at most this (then the S is tried again: a forward arc that
+// has passed the car ahead would otherwise turn on until the far lane edge stops it); a vehicle
+// turned further than kMaxTilt from the road is not leaving a parallel spot any more.
+constexpr double kMaxMoveTurn = kPi / 8.0;
 constexpr double kMaxTilt = kPi / 2.0;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kOutputInterval = 0.1;  // [m] points of a move: chords within 0.3 mm of a 5 m arc
@@ -214,13 +212,6 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
     // 1. The S from here.
     std::vector<CurvaturePath> turn_paths;
     PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, kInfinity, &turn_paths, moves.size() > 1);
-    if (std::getenv("SHUNT_DEBUG") != nullptr) {
-      std::fprintf(stderr, "pose %.3f %.3f %.3f tilt %.3f\n", pose.x, pose.y, pose.yaw, tilt_at(pose));
-      for (const auto& c : s.candidates) {
-        std::fprintf(stderr, "   %s %s clr %.3f\n", c.rejection ? to_string(c.rejection->outcome) : "ok",
-                     c.rejection ? c.rejection->detail.c_str() : "", c.clearance);
-      }
-    }
     for (std::size_t i = 0; i < s.candidates.size(); ++i) {
       PathCandidate& c = s.candidates[i];
       if (c.rejection || c.clearance < ctx.smallest_margin) continue;

@@ -608,8 +608,8 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
       }
       if (moves.candidates.empty() && !moves.failure && moves.stopped == StopReason::kNone) continue;  // has none
       const Selection sel = select_candidate(moves, smallest_margin);
-      result.evaluation_table.push_back({planner->type(), smallest_margin, 0.0, sel.outcome,
-                                         sel.chosen != nullptr ? "shunting" : sel.detail});
+      result.evaluation_table.push_back(
+          {planner->type(), smallest_margin, 0.0, sel.outcome, sel.chosen != nullptr ? "shunting" : sel.detail});
       if (sel.chosen != nullptr) {
         accept(*sel.chosen, planner->type());
         publish_checked(result, checker, smallest_margin, params);
