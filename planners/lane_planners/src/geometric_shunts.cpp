@@ -170,11 +170,14 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
   const auto on_road = center.project(to_vec(start));
   const double side = on_road.lateral < 0.0 ? 1.0 : -1.0;  // +1: the road is to the left
   const double limit = ctx.smallest_margin + kStopSlack;
+  // The moves' lane check: the footprint grown by lane_departure_check_expansion_margin (and 1 cm
+  // where the start has it).
   Footprint lane_fp = vehicle_footprint(ctx.vehicle, p.lane_departure_check_expansion_margin + kLaneSlack);
   if (!ctx.world.footprint_inside(footprint_corners(lane_fp, start))) {
-    lane_fp = vehicle_footprint(ctx.vehicle);
+    lane_fp = vehicle_footprint(ctx.vehicle, p.lane_departure_check_expansion_margin);
     if (!ctx.world.footprint_inside(footprint_corners(lane_fp, start))) {
-      return fail(AttemptOutcome::kStartInvalid, "the start is not inside the lanes");
+      return fail(AttemptOutcome::kLaneDeparture,
+                  "the start's footprint (with lane_departure_check_expansion_margin) leaves the lanes");
     }
   }
 
