@@ -108,11 +108,12 @@ MoveLimit drive_until_clear(const PlanningContext& ctx, const Pose2& from, doubl
 }
 
 // The smallest clearance [m] to the static obstacles over the first `length` [m] of `path`, by
-// conservative advancement: from a pose with clearance c the next one is (c - floor) / L further
-// (L bounds how fast any point of the footprint moves per metre driven), at least kMinStep /
-// 2: nothing between two samples comes closer than `floor` unless a sample does, and within 1.6
-// cm... The returned value is the smallest sample; a caller accepting it against a margin adds
-// kStopSlack. Stops early (returning what it found) once a sample is below `floor`.
+// conservative advancement: from a pose with clearance c the next sample is (c - floor) / L
+// further (L bounds how fast any point of the footprint moves per metre driven), so nothing
+// between two samples comes closer than `floor`; where that step is below 1 cm it is 1 cm, and
+// the clearance between those samples can fall below them by at most L x 0.5 cm (0.8 cm at
+// R_min 5 m). Returns at the first sample below `floor` (then not the minimum: a value below
+// `floor` means "closer than floor somewhere").
 ObjectChecker::Clearance dense_clearance(const PlanningContext& ctx, const CurvaturePath& path, double length,
                                          double floor) {
   const double lipschitz = 1.0 + path.max_abs_curvature() * ctx.objects.footprint().bounding_radius();
