@@ -15,6 +15,7 @@
 // shipped search (shift, geometric, freespace fallback; freespace_planner.time_limit 1000 ms to
 // bound the run). collision_check_margin_from_front_object is 0 for all (Autoware's 5 m skips
 // every backward candidate in a parallel spot). Results in bench/RESULTS.md.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -143,27 +144,45 @@ std::string check(const PullOutPath& path, const Street& st, const VehicleInfo& 
 struct Tally {
   int solved{0};
   int total{0};
-  int cusps{0};
+  int cusps{0};  // changes of direction (forward <-> reverse) of the paths found
+  int stops{0};  // stops between partial paths (direction changes and stops to re-steer)
+  int max_cusps{0};
   std::vector<double> ms;
+  std::map<std::string, int> by_planner;  // paths found per planner type
 };
+
+int direction_changes(const PullOutPath& path) {
+  int n = 0;
+  for (std::size_t k = 0; k + 1 < path.partial_paths.size(); ++k) {
+    if (oracle::direction_of(path.partial_paths[k]) != oracle::direction_of(path.partial_paths[k + 1])) ++n;
+  }
+  return n;
+}
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  // --why: the evaluation table's last row of every spot the shunting planner leaves unsolved.
+  const bool why = argc > 1 && std::string(argv[1]) == "--why";
   const VehicleInfo v;
   struct Planner {
     const char* name;
     StartPlannerParameters params;
   };
   std::vector<Planner> planners;
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 4; ++k) {
     StartPlannerParameters p;
     p.collision_check_margin_from_front_object = 0.0;
     p.freespace_planner.time_limit = 1000.0;
     if (k == 0) p.search_priority = {PlannerType::kShift};
-    if (k == 1) p.search_priority = {PlannerType::kGeometric};
-    if (k < 2) p.freespace_planner.enable_freespace_planner = false;
-    planners.push_back({k == 0 ? "shift" : k == 1 ? "geometric" : "default search", p});
+    if (k == 1 || k == 2) p.search_priority = {PlannerType::kGeometric};
+    if (k == 1) p.geometric_pull_out_max_shunts = 0;
+    if (k < 3) p.freespace_planner.enable_freespace_planner = false;
+    planners.push_back({k == 0   ? "shift"
+                        : k == 1 ? "geometric S only"
+                        : k == 2 ? "geometric with shunts"
+                                 : "default search",
+                        p});
   }
   std::map<std::string, std::map<std::string, Tally>> by_family;  // family -> planner -> tally
   std::map<std::string, std::map<double, Tally>> by_slack;        // planner -> slack -> tally
@@ -193,12 +212,21 @@ int main() {
                                             " slack " + std::to_string(slack) + ": " + why);
                 }
               }
+              if (why && !ok && std::string(pl.name) == "geometric with shunts" && !r.evaluation_table.empty()) {
+                std::printf("unsolved: %s kerb %.2f slack %.1f: %s\n", family.c_str(), kerb, slack,
+                            describe(r.evaluation_table.back()).c_str());
+              }
               for (Tally* t : {&by_family[family][pl.name], &by_slack[pl.name][slack]}) {
                 ++t->total;
                 t->ms.push_back(ms);
                 if (ok) {
                   ++t->solved;
-                  t->cusps += static_cast<int>(r.path.partial_paths.size()) - 1;
+                  t->cusps += direction_changes(r.path);
+                  t->max_cusps = std::max(t->max_cusps, direction_changes(r.path));
+                  t->stops += static_cast<int>(r.path.partial_paths.size()) - 1;
+                  const bool shunted = r.path.planner_type == PlannerType::kGeometric && !r.evaluation_table.empty() &&
+                                       r.evaluation_table.back().detail == "shunting";
+                  ++t->by_planner[std::string(to_string(r.path.planner_type)) + (shunted ? " (shunts)" : "")];
                 }
               }
             }
@@ -210,21 +238,47 @@ int main() {
   double load[3] = {0, 0, 0};
   if (::getloadavg(load, 3) != 3) load[0] = -1;
   std::printf("load average %.2f %.2f %.2f\n\n", load[0], load[1], load[2]);
+  const auto mean = [](int sum, int n) { return n ? static_cast<double>(sum) / n : 0.0; };
+  const auto found_by = [](const Tally& t) {
+    std::string out;
+    for (const auto& [name, n] : t.by_planner) out += (out.empty() ? "" : ", ") + name + " " + std::to_string(n);
+    return out;
+  };
   std::printf(
-      "| family | planner | solved | mean direction changes | p50 [ms] | p95 [ms] |\n|---|---|---|---|---|---|\n");
+      "| family | planner | solved | mean direction changes | mean stops | p50 [ms] | p95 [ms] | found by |\n"
+      "|---|---|---|---|---|---|---|---|\n");
   for (auto& [family, rows] : by_family) {
     for (const Planner& pl : planners) {
       Tally& t = rows[pl.name];
       const auto s = pullout::bench::summarize(t.ms);
-      std::printf("| %s | %s | %d/%d | %.2f | %.2f | %.2f |\n", family.c_str(), pl.name, t.solved, t.total,
-                  t.solved ? static_cast<double>(t.cusps) / t.solved : 0.0, s.p50, s.p95);
+      std::printf("| %s | %s | %d/%d | %.2f | %.2f | %.2f | %.2f | %s |\n", family.c_str(), pl.name, t.solved, t.total,
+                  mean(t.cusps, t.solved), mean(t.stops, t.solved), s.p50, s.p95, found_by(t).c_str());
     }
   }
-  std::printf("\n| planner | slack [m] | solved | p50 [ms] | p95 [ms] |\n|---|---|---|---|---|\n");
+  std::printf(
+      "\n| planner | slack [m] | solved | mean direction changes | max direction changes | p50 [ms] | p95 [ms] | "
+      "found by |\n|---|---|---|---|---|---|---|---|\n");
   for (const Planner& pl : planners) {
     for (auto& [slack, t] : by_slack[pl.name]) {
       const auto s = pullout::bench::summarize(t.ms);
-      std::printf("| %s | %.1f | %d/%d | %.2f | %.2f |\n", pl.name, slack, t.solved, t.total, s.p50, s.p95);
+      std::printf("| %s | %.1f | %d/%d | %.2f | %d | %.2f | %.2f | %s |\n", pl.name, slack, t.solved, t.total,
+                  mean(t.cusps, t.solved), t.max_cusps, s.p50, s.p95, found_by(t).c_str());
+    }
+  }
+  std::printf("\n| planner | spots | solved | p50 [ms] | p95 [ms] |\n|---|---|---|---|---|\n");
+  for (const Planner& pl : planners) {
+    for (double from : {0.8, 1.0}) {
+      std::vector<double> ms;
+      int solved = 0;
+      int total = 0;
+      for (auto& [slack, t] : by_slack[pl.name]) {
+        if (slack < from - 1e-9) continue;
+        ms.insert(ms.end(), t.ms.begin(), t.ms.end());
+        solved += t.solved;
+        total += t.total;
+      }
+      const auto s = pullout::bench::summarize(ms);
+      std::printf("| %s | slack >= %.1f m | %d/%d | %.2f | %.2f |\n", pl.name, from, solved, total, s.p50, s.p95);
     }
   }
   std::printf("\noracle failures: %zu\n", oracle_failures.size());

@@ -195,10 +195,12 @@ TEST_F(PullOutFlow, BoxedInGivesAStopPathAndNoPathWithReasons) {
 
 TEST_F(PullOutFlow, BoxedInWithoutBackwardSearchTriesEveryMargin) {
   // Only the current pose as start candidate: every margin of the ladder is tried, each attempt
-  // recorded with its outcome.
+  // recorded with its outcome. Single moves only: shunting (forward first, without the backward
+  // search) gets out of this spot.
   const std::string config = temp_.write_file("no_back.yaml",
                                               "start_planner:\n"
                                               "  enable_back: false\n"
+                                              "  geometric_pull_out_max_shunts: 0\n"
                                               "dds:\n"
                                               "  profiles_file: " +
                                                   loopback_profiles_path() + "\n");

@@ -168,6 +168,8 @@ StartPlannerParameters family_parameters() {
   // Autoware skips backward candidates within 5 m of the car ahead (room for a shift); in a
   // parallel spot every pose behind is that close, and reversing is what a driver does first.
   p.collision_check_margin_from_front_object = 0.0;
+  // The two-arc S alone (this file's bound); shunting is tested in test_geometric_shunts.cpp.
+  p.geometric_pull_out_max_shunts = 0;
   return p;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "geometric_internal.hpp"
 #include "pullout/collision/footprint.hpp"
 #include "pullout/geometry/angle.hpp"
 #include "pullout/lane_planners/two_turn_path.hpp"
@@ -22,6 +23,10 @@ constexpr double kKerbReach = 1.0;
 // [m] Left between the swing of a first arc at R_min and the kerb-side margin that yields to it.
 constexpr double kSwingSlack = 0.01;
 constexpr int kClearanceBisections = 14;  // a bracket of 1.2 m shrinks below 0.1 mm
+// A tilted start whose first arc at R_min swings over the kerb-side edge: radii tried, each this
+// factor above the last, up to kMaxFirstRadius [m].
+constexpr double kFirstRadiusGrowth = 1.05;
+constexpr double kMaxFirstRadius = 200.0;
 
 using Edges = std::vector<std::pair<Vec2, Vec2>>;
 
@@ -55,18 +60,6 @@ double distance_to_lane_edge(const Edges& edges, const Vec2& p, const Vec2& dir)
   return best;
 }
 
-// How far [m] a footprint corner at (along, across) from base_link - `along` ahead (> 0) or behind,
-// `across` > 0 outwards on the side away from the arc's centre - gets beyond the line where that
-// side of the footprint was at the arc's start, while the vehicle turns by `turn` [rad] on an arc
-// of radius r: the corner circles the centre at hypot(r + across, along), and its excursion
-// peaks once the vehicle has turned by atan(along / (r + across)).
-double corner_swing(double r, double along, double across, double turn) {
-  const double u = r + across;
-  const double radius = std::hypot(u, along);
-  const double peak = std::atan2(along, u);
-  return (turn >= peak ? radius : radius * std::cos(peak - turn)) - u;
-}
-
 // The largest expansion [m], up to `cap`, of the side `side` of `base` with which the footprint
 // at `pose` stays inside the lanes (bisection); -1 when `base` itself does not.
 double side_clearance(const LaneWorld& world, const Footprint& base, double Footprint::*side, const Pose2& pose,
@@ -89,8 +82,13 @@ double side_clearance(const LaneWorld& world, const Footprint& base, double Foot
 
 }  // namespace
 
-PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2& start,
-                                         const StopCondition& stop) const {
+PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& start, const StopCondition& stop,
+                                      double usable_margin, std::vector<CurvaturePath>* turn_paths,
+                                      bool turn_candidates) {
+  // One path per candidate (empty for those with no geometry), when asked for.
+  const auto keep = [turn_paths](const CurvaturePath& path) {
+    if (turn_paths != nullptr) turn_paths->push_back(path);
+  };
   const auto& p = ctx.parameters;
   PlannerCandidates out;
   const double steer = ctx.vehicle.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale;
@@ -109,6 +107,9 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
   const Polyline& center = ctx.road.centerline;
   const auto start_on_road = center.project(to_vec(start));
   const double side = start_on_road.lateral < 0.0 ? 1.0 : -1.0;  // +1: the road is to the left
+  // How far the start is turned towards the road (0: parallel to it; a shunting manoeuvre's
+  // later start poses). The lanes' edge on the kerb side runs along the road.
+  const double tilt = std::max(0.0, side * normalize_angle(start.yaw - center.pose_at(start_on_road.s).yaw));
   double Footprint::*const road_side = side > 0.0 ? &Footprint::left : &Footprint::right;
   double Footprint::*const kerb_side = side > 0.0 ? &Footprint::right : &Footprint::left;
   Footprint fp = plain;
@@ -117,7 +118,7 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
   // Room beside the kerb side at the start (with the front and rear margins: the corners count).
   const double kerb_cap = margin + kKerbReach;
   const double kerb_gap = std::max(0.0, side_clearance(ctx.world, fp, kerb_side, start, kerb_cap));
-  const double swing_at_r_min = corner_swing(r_min, fp.rear, plain.*kerb_side, kPi);
+  const double swing_at_r_min = corner_swing(r_min, fp.rear, plain.*kerb_side, kPi, tilt);
   const double kerb_margin = std::clamp(kerb_gap - swing_at_r_min - kSwingSlack, kerb_floor, margin);
   fp.*road_side += margin;
   fp.*kerb_side += kerb_margin;
@@ -126,14 +127,23 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
   const double kerb_side_half_width = fp.*kerb_side;
   // Room between the lane-check footprint and the lane edge on the kerb side, at the start
   // (unbounded when no edge is within reach).
-  const double kerb_room = kerb_gap >= kerb_cap ? kInfinity : kerb_gap - kerb_margin;
+  // (The gap is measured across the vehicle; across the tilted edge it is cos(tilt) of that.)
+  const double kerb_room = kerb_gap >= kerb_cap ? kInfinity : (kerb_gap - kerb_margin) * std::cos(tilt);
   // The first arc (around a centre on the road side) swings the rear corner on the kerb side
   // outwards by up to hypot(R + w, rear) - (R + w). R_min unless that crosses the kerb-side edge;
   // then the smallest radius whose swing fits: hypot(u, rear) <= u + room, u = R + w.
   double r_first = r_min;
   if (kerb_room > 0.0 && std::isfinite(kerb_room) &&
-      corner_swing(r_min, fp.rear, kerb_side_half_width, kPi) > kerb_room) {
+      corner_swing(r_min, fp.rear, kerb_side_half_width, kPi, tilt) > kerb_room) {
+    // Parallel start: hypot(u, rear) <= u + room. Tilted: the swing shrinks with the radius too;
+    // raised in steps until it fits (the closed form is the first step's floor).
     r_first = std::max(r_min, (fp.rear * fp.rear - kerb_room * kerb_room) / (2.0 * kerb_room) - kerb_side_half_width);
+    if (tilt > 0.0) {
+      r_first = r_min;
+      while (r_first < kMaxFirstRadius && corner_swing(r_first, fp.rear, kerb_side_half_width, kPi, tilt) > kerb_room) {
+        r_first *= kFirstRadiusGrowth;
+      }
+    }
   }
   // The base end pose: where two arcs of r_first end on the centerline from a parallel start
   // (Autoware's), 2 sqrt(R^2 - (R - d/2)^2) ahead; candidates move it 0..9 m further.
@@ -141,21 +151,29 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
   const double q = r_first * r_first - (r_first - half_offset) * (r_first - half_offset);
   const double s_base = start_on_road.s + 2.0 * std::sqrt(std::max(q, 0.0));
 
-  for (int k = 0; k < kEndOffsets; ++k) {
+  // Tilted starts (a shunting manoeuvre's): after the S candidates, two turns at R_min joined by
+  // a tangent of 0..9 m (which may turn away from the road first: a counter-arc onto the lane).
+  const int rounds = turn_candidates ? 2 * kEndOffsets : kEndOffsets;
+  for (int round = 0; round < rounds; ++round) {
     out.stopped = stop.check();
     if (out.stopped != StopReason::kNone) break;
+    const bool tangent_round = round >= kEndOffsets;
+    const int k = tangent_round ? round - kEndOffsets : round;
     // An S of two arcs to the end pose on the centerline: the first arc at r_first, the second's
     // radius solved (Vorobieva). Where no S reaches it (a start across the road, out of a
     // perpendicular bay), two turns at R_min joined by a k m tangent.
     std::optional<TwoTurnPath> turns;
     const double s_end = s_base + k;
-    if (q >= 0.0 && s_end <= center.length()) turns = solve_arc_pair(start, center.pose_at(s_end), r_first, r_min);
+    if (!tangent_round && q >= 0.0 && s_end <= center.length()) {
+      turns = solve_arc_pair(start, center.pose_at(s_end), r_first, r_min);
+    }
     const bool arc_pair = turns.has_value();
     if (!arc_pair) turns = solve_two_turn(start, window, {kappa, 0.0, static_cast<double>(k)});
     if (!turns) {
       PathCandidate none;
       none.rejection = Failure{AttemptOutcome::kNoGeometry, "no two-arc path to the centerline"};
       out.candidates.push_back(std::move(none));
+      keep({});
       continue;
     }
     if (arc_pair) {
@@ -168,13 +186,14 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
       const double far_room =
           distance_to_lane_edge(edges, to_vec(end), side * left_normal(heading(end.yaw))) - road_side_half_width;
       const double far_swing = corner_swing(r_second, fp.front, road_side_half_width, arcs[1].length / r_second);
-      const double kerb_swing = corner_swing(r_first, fp.rear, kerb_side_half_width, arcs[0].length / r_first);
+      const double kerb_swing = corner_swing(r_first, fp.rear, kerb_side_half_width, arcs[0].length / r_first, tilt);
       if (far_swing > far_room || kerb_swing > kerb_room) {
         PathCandidate swing;
         swing.rejection = Failure{AttemptOutcome::kLaneDeparture,
                                   far_swing > far_room ? "the front corner swings over the far lane edge"
                                                        : "the rear corner swings over the kerb-side edge"};
         out.candidates.push_back(std::move(swing));
+        keep({});
         continue;
       }
     }
@@ -219,8 +238,16 @@ PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2
       return divide && d < 0.99 * first_turn_length ? v1 : v;  // chords are shorter than arcs
     };
     out.candidates.push_back(make_turn_candidate(ctx, *turns, options, velocity, segment));
+    keep(turns->path);
+    const PathCandidate& added = out.candidates.back();
+    if (std::isfinite(usable_margin) && !added.rejection && added.clearance >= usable_margin) break;
   }
   return out;
+}
+
+PlannerCandidates GeometricPullOut::plan(const PlanningContext& ctx, const Pose2& start,
+                                         const StopCondition& stop) const {
+  return arc_pair_candidates(ctx, start, stop, kInfinity, nullptr, false);
 }
 
 }  // namespace pullout

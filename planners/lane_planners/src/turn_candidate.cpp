@@ -27,6 +27,15 @@ Pose2 pose_along(const CurvaturePath& path, double s) {
   return p;
 }
 
+std::vector<double> cumulative_distance(const std::vector<Pose2>& poses) {
+  std::vector<double> d(poses.size(), 0.0);
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    d[i] = d[i - 1] + std::hypot(poses[i].x - poses[i - 1].x, poses[i].y - poses[i - 1].y);
+  }
+  return d;
+}
+}  // namespace
+
 // The smallest clearance to the obstacles over the path's first `length` metres. Samples every
 // kCheckInterval can miss the closest approach of a corner passing an obstacle's corner by
 // centimetres. The clearance is Lipschitz in the distance driven, with constant
@@ -88,15 +97,6 @@ ObjectChecker::Clearance refined_clearance(const PlanningContext& ctx, const Cur
   }
   return best;
 }
-
-std::vector<double> cumulative_distance(const std::vector<Pose2>& poses) {
-  std::vector<double> d(poses.size(), 0.0);
-  for (std::size_t i = 1; i < poses.size(); ++i) {
-    d[i] = d[i - 1] + std::hypot(poses[i].x - poses[i - 1].x, poses[i].y - poses[i - 1].y);
-  }
-  return d;
-}
-}  // namespace
 
 Polyline turn_window(const PlanningContext& ctx, const Pose2& start) {
   const double s = ctx.road.centerline.project(to_vec(start)).s;

@@ -25,6 +25,10 @@ struct TurnSegmentation {
   bool stop_at_splits{true};
 };
 
+// The smallest clearance to the static obstacles over the first `length` [m] of `path`, exact to
+// about 1 cm (samples every 0.5 m, refined around the local minima; see the .cpp).
+ObjectChecker::Clearance refined_clearance(const PlanningContext& context, const CurvaturePath& path, double length);
+
 // The window of the road centerline a two-turn path from `start` is solved on.
 Polyline turn_window(const PlanningContext& context, const Pose2& start);
 

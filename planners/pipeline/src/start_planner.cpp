@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -502,7 +503,11 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     }
   }
   double horizon = 0.0;
-  for (double m : params.collision_check_margins) horizon = std::max(horizon, m);
+  double smallest_margin = std::numeric_limits<double>::infinity();
+  for (double m : params.collision_check_margins) {
+    horizon = std::max(horizon, m);
+    smallest_margin = std::min(smallest_margin, m);
+  }
   const PlanningContext context{world,
                                 road,
                                 *pull_out,
@@ -513,7 +518,10 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
                                 horizon,
                                 request.ego_pose,
                                 request.occupancy_grid ? &*request.occupancy_grid : nullptr,
-                                &obstacle_polygons};
+                                &obstacle_polygons,
+                                smallest_margin,
+                                params.enable_back ? params.max_back_distance : 0.0,
+                                std::abs(params.backward_velocity)};
 
   std::vector<std::unique_ptr<PullOutPlanner>> planners;
   for (PlannerType t : params.search_priority) {
@@ -584,6 +592,32 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
       if (result.stopped != StopReason::kNone) break;
     }
     if (result.stopped != StopReason::kNone) break;
+  }
+
+  // Nothing found in one move: the planners' multi-move manoeuvres (the geometric planner's
+  // shunting) from the vehicle's pose, in search_priority order, at the smallest margin. They
+  // reverse on their own (as far as the room behind and max_back_distance allow), so the start
+  // candidates behind the vehicle add nothing.
+  if (result.stopped == StopReason::kNone) {
+    for (const auto& planner : planners) {
+      result.stopped = stop.check();
+      if (result.stopped != StopReason::kNone) break;
+      const PlannerCandidates moves = planner->plan_multi_move(context, request.ego_pose, stop);
+      if (moves.stopped == StopReason::kDeadline || moves.stopped == StopReason::kCancelled) {
+        result.stopped = moves.stopped;
+      }
+      if (moves.candidates.empty() && !moves.failure && moves.stopped == StopReason::kNone) continue;  // has none
+      const Selection sel = select_candidate(moves, smallest_margin);
+      result.evaluation_table.push_back(
+          {planner->type(), smallest_margin, 0.0, sel.outcome, sel.chosen != nullptr ? "shunting" : sel.detail});
+      if (sel.chosen != nullptr) {
+        accept(*sel.chosen, planner->type());
+        publish_checked(result, checker, smallest_margin, params);
+        finish(result);
+        return result;
+      }
+      if (result.stopped != StopReason::kNone) break;
+    }
   }
 
   // Nothing found: the freespace fallback (unless it was searched in the order already).

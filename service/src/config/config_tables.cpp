@@ -347,6 +347,8 @@ const Table<StartPlannerParameters>& start_planner_table() {
           field("divide_pull_out_path", &P::divide_pull_out_path, "", AnyValue{}, "stop between the arcs to re-steer"),
           field("geometric_collision_check_distance_from_end", &P::geometric_collision_check_distance_from_end, "m",
                 any_number(), ""),
+          field("geometric_pull_out_max_shunts", &P::geometric_pull_out_max_shunts, "", in(0, 50),
+                "forward and reverse full-lock moves before the S where no S gets out (0: none)"),
 
           note<P>("--- clothoid pull-out: clothoid-arc-clothoid turns ---", true),
           field("clothoid_initial_velocity", &P::clothoid_initial_velocity, "m/s", in(0.01, 20.0), ""),

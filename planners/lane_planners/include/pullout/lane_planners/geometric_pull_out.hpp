@@ -45,6 +45,31 @@
 //   single:           (v, v^2 / (2 L)).
 // Autoware reads v from a field it never sets, so all its pairs are (0, 0), and its undivided
 // formula parses as (v^2 / 2) * L.
+//
+// Shunting (geometric_pull_out_max_shunts > 0; the multi-step un-parking of Vorobieva et al.):
+// where no single S gets out of a parallel spot (less than about 2.2 m of room ahead and behind
+// together), the pipeline asks plan_multi_move() from the vehicle's pose, after the margin ladder
+// found nothing. The manoeuvre, as a driver does it:
+//   0. reverse straight until just clear of what is behind (enable_back; up to
+//      max_back_distance);
+//   1. from the pose reached, try the S above (with a tilted start: the kerb-side swing and gap
+//      are taken across the tilted lane edge); if one is usable at the smallest margin, done;
+//   2. else drive forward at full lock towards the road (radius R_min) until just clear of what is
+//      ahead (or after turning by 22.5 degrees), then reverse at full lock the other way until
+//      just clear of what is behind (where the rear corner meets the kerb at once: straight back):
+//      both turn the vehicle further towards the road; back to 1, at most
+//      geometric_pull_out_max_shunts times. From a turned pose, two turns at R_min joined by a
+//      0..9 m tangent are tried after the S (a counter-arc onto the lane).
+// "Just clear": every pose of a move keeps the footprint (expanded by
+// lane_departure_check_expansion_margin, and 1 cm) inside the lanes and at least the smallest
+// collision margin plus 2 cm from every static obstacle (sampled every 2 cm at most and bisected
+// to 0.1 mm where a move ends). The moves and the exit are then checked again densely
+// (conservative advancement: steps of (clearance - floor) / L, L = 1 + curvature x the
+// footprint's bounding radius, at least 1 cm) against the smallest margin plus 1 cm. A move that
+// gets less than 1 cm is a dead end. Output: one partial path per move (forward at
+// geometric_pull_out_velocity, reverse at |backward_velocity|, each capped at what
+// maximum_longitudinal_acc reaches over half the move; velocity 0 at its end, points every 10 cm),
+// then the S as above.
 #pragma once
 
 #include "pullout/lane_planners/pull_out_planner.hpp"
@@ -55,6 +80,10 @@ class GeometricPullOut final : public PullOutPlanner {
  public:
   PlannerType type() const override { return PlannerType::kGeometric; }
   PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const StopCondition& stop) const override;
+  // The shunting manoeuvre (see the top of this file): one candidate, or a failure saying where it
+  // got stuck. Empty (no failure) when geometric_pull_out_max_shunts is 0.
+  PlannerCandidates plan_multi_move(const PlanningContext& context, const Pose2& start,
+                                    const StopCondition& stop) const override;
 };
 
 }  // namespace pullout

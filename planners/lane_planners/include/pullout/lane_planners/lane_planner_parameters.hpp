@@ -36,6 +36,8 @@ struct LanePlannerParameters {
   double geometric_pull_out_max_steer_angle_margin_scale{0.72};  // x vehicle max steer
   bool divide_pull_out_path{true};                               // stop between the arcs to re-steer
   double geometric_collision_check_distance_from_end{0.0};       // [m]
+  // Shunts (a forward and a reverse full-lock arc) before the S, where no single S gets out; 0: none.
+  int geometric_pull_out_max_shunts{10};
 
   // --- clothoid pull-out (clothoid-arc-clothoid turns) ---
   double clothoid_initial_velocity{1.0};                               // [m/s]

@@ -39,6 +39,13 @@ struct PlanningContext {
   Pose2 ego;
   const OccupancyGrid* occupancy_grid{nullptr};
   const std::vector<Polygon>* obstacle_polygons{nullptr};
+  // The smallest margin of the ladder [m]: how close a multi-move manoeuvre drives to an obstacle
+  // before it stops to change direction ("just clear").
+  double smallest_margin{0.0};
+  // How far [m] a multi-move manoeuvre may reverse straight before it turns (max_back_distance;
+  // 0 without enable_back), and the speed [m/s] > 0 of its reverse moves (|backward_velocity|).
+  double max_back_distance{0.0};
+  double reverse_speed{1.0};
 };
 
 // Why an attempt or a candidate failed: the typed outcome and a detail for people ("object 7",
@@ -77,6 +84,15 @@ class PullOutPlanner {
   // geometric failure.
   virtual PlannerCandidates plan(const PlanningContext& context, const Pose2& start,
                                  const StopCondition& stop) const = 0;
+  // Multi-move manoeuvres from `start` (several partial paths with changes of direction, the
+  // vehicle stopped at each): what a driver does where no single move gets out. The pipeline asks
+  // for them only after plan() found nothing usable at any margin from any start candidate, and
+  // uses them at context.smallest_margin. Same contract as plan(); by default a planner has none
+  // (no candidates, no failure).
+  virtual PlannerCandidates plan_multi_move(const PlanningContext& /*context*/, const Pose2& /*start*/,
+                                            const StopCondition& /*stop*/) const {
+    return {};
+  }
 };
 
 // The first candidate usable at `margin` (nullptr if none), and the evaluation-table outcome:

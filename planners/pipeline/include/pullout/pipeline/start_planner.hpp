@@ -3,9 +3,11 @@
 //
 //   request -> validate -> world (lanes, static objects) -> for each margin in
 //   collision_check_margins: for each planner in search_priority: plan, check lane departure and
-//   static collision -> first success -> velocities -> PullOutPath. Nothing found and
-//   freespace_planner.enable_freespace_planner: the freespace pull-out (hybrid A*) from the ego
-//   pose. A request with an occupancy grid and no lanes (allowed when the freespace planner is
+//   static collision -> first success -> velocities -> PullOutPath. Nothing found: each
+//   planner's multi-move manoeuvre from the ego pose at the smallest margin (the geometric
+//   planner's shunting, geometric_pull_out_max_shunts > 0; evaluation-table detail "shunting").
+//   Still nothing and freespace_planner.enable_freespace_planner: the freespace pull-out (hybrid
+//   A*) from the ego pose. A request with an occupancy grid and no lanes (allowed when the freespace planner is
 //   enabled) is a pure freespace problem: hybrid A* straight to the goal pose.
 //
 // Thread safety: StartPlanner is immutable after construction; plan() may be called concurrently

@@ -1,0 +1,296 @@
+// The geometric planner's shunting manoeuvre (see geometric_pull_out.hpp): moves at full lock,
+// alternating forward and reverse, each until just clear, then the S.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "geometric_internal.hpp"
+#include "pullout/collision/footprint.hpp"
+#include "pullout/geometry/angle.hpp"
+#include "pullout/lane_planners/geometric_pull_out.hpp"
+#include "turn_candidate.hpp"
+
+namespace pullout {
+
+namespace {
+
+// [m] Added to the smallest collision margin where a move stops: the clearance between samples
+// can fall below a sampled one by at most (Lipschitz constant <= 1.6) x half the largest step.
+constexpr double kStopSlack = 0.02;
+// [m] Added to the smallest margin for the dense clearance of the S: between samples 1 cm apart
+// the clearance falls by at most 1.6 x 0.5 cm below them.
+constexpr double kDenseSlack = 0.01;
+constexpr double kMinStep = 0.02;    // [m] sampling of a move where the clearance is near the limit
+constexpr double kMaxStep = 0.1;     // [m] and where it is not (and of the lane check)
+constexpr int kEndBisections = 10;   // a bracket of 0.1 m shrinks to 0.1 mm
+constexpr double kMinMove = 0.01;    // [m] a move shorter than this is a dead end
+constexpr double kLaneSlack = 0.01;  // [m] footprint growth of the moves' lane check
+// [rad] A move turns the vehicle by at most this (then the S is tried again: a forward arc that
+// has passed the car ahead would otherwise turn on until the far lane edge stops it); a vehicle
+// turned further than kMaxTilt from the road is not leaving a parallel spot any more.
+constexpr double kMaxMoveTurn = kPi / 8.0;
+constexpr double kMaxTilt = kPi / 2.0;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr double kOutputInterval = 0.1;  // [m] points of a move: chords within 0.3 mm of a 5 m arc
+
+struct Move {
+  Pose2 from;
+  double curvature{0.0};  // [1/m] of the path driven, left positive
+  double direction{1.0};  // +1 forward, -1 reverse
+  double length{0.0};     // [m] > 0
+
+  // The pose after driving s [m] (0 <= s <= length) in the move's direction.
+  Pose2 at(double s) const { return CurvaturePath::advance(from, {1.0, curvature, curvature}, direction * s); }
+  // Its poses as a path driven forward (a reverse move's from its end).
+  CurvaturePath path() const {
+    const CurvaturePiece piece{length, curvature, curvature};
+    return CurvaturePath(direction > 0.0 ? from : at(length), {piece});
+  }
+};
+
+struct MoveLimit {
+  double length{0.0};
+  bool lanes{false};  // stopped by the lanes (else by an obstacle or the cap)
+};
+
+// How far the vehicle can drive from `from` with curvature k in `direction`, up to `cap` [m]:
+// every pose keeps `lane_fp` inside the lanes, and the clearance never falls below `limit` while
+// it falls (driving away from an obstacle already closer than `limit` is allowed).
+MoveLimit drive_until_clear(const PlanningContext& ctx, const Pose2& from, double k, double direction, double cap,
+                            const Footprint& lane_fp, double limit) {
+  const Move m{from, k, direction, cap};
+  const double lipschitz = 1.0 + std::abs(k) * ctx.objects.footprint().bounding_radius();
+  const double horizon = limit + lipschitz * kMaxStep + 1.0;
+  const auto clearance = [&](double s) { return ctx.objects.clearance(m.at(s), horizon).distance; };
+  const auto inside = [&](double s) { return ctx.world.footprint_inside(footprint_corners(lane_fp, m.at(s))); };
+  // Whether s is reachable from the last good sample (clearance c_good there).
+  const auto good = [&](double s, double c_good, bool& lanes, double& c) {
+    lanes = !inside(s);
+    if (lanes) return false;
+    c = clearance(s);
+    return !(c < limit && c < c_good);
+  };
+  double s = 0.0;
+  double c = clearance(0.0);
+  MoveLimit out;
+  while (s < cap) {
+    const double step = std::clamp((c - limit) / lipschitz, kMinStep, kMaxStep);
+    const double next = std::min(cap, s + step);
+    bool lanes = false;
+    double c_next = 0.0;
+    if (good(next, c, lanes, c_next)) {
+      s = next;
+      c = c_next;
+      continue;
+    }
+    // The end lies in (s, next]: bisect.
+    double lo = s;
+    double hi = next;
+    for (int i = 0; i < kEndBisections; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      bool mid_lanes = false;
+      double c_mid = 0.0;
+      if (good(mid, c, mid_lanes, c_mid)) {
+        lo = mid;
+      } else {
+        hi = mid;
+        lanes = mid_lanes;
+      }
+    }
+    out.length = lo;
+    out.lanes = lanes;
+    return out;
+  }
+  out.length = cap;
+  return out;
+}
+
+// The smallest clearance [m] to the static obstacles over the first `length` [m] of `path`, by
+// conservative advancement: from a pose with clearance c the next sample is (c - floor) / L
+// further (L bounds how fast any point of the footprint moves per metre driven), so nothing
+// between two samples comes closer than `floor`; where that step is below 1 cm it is 1 cm, and
+// the clearance between those samples can fall below them by at most L x 0.5 cm (0.8 cm at
+// R_min 5 m). Returns at the first sample below `floor` (then not the minimum: a value below
+// `floor` means "closer than floor somewhere").
+ObjectChecker::Clearance dense_clearance(const PlanningContext& ctx, const CurvaturePath& path, double length,
+                                         double floor) {
+  const double lipschitz = 1.0 + path.max_abs_curvature() * ctx.objects.footprint().bounding_radius();
+  const double horizon = floor + lipschitz * kMaxStep * 5.0 + 1.0;
+  ObjectChecker::Clearance best;
+  double s = 0.0;
+  for (;;) {
+    Pose2 q = path.start();
+    double rest = std::min(s, length);
+    for (const CurvaturePiece& piece : path.pieces()) {
+      if (rest <= piece.length) {
+        q = CurvaturePath::advance(q, piece, rest);
+        rest = 0.0;
+        break;
+      }
+      q = CurvaturePath::advance(q, piece, piece.length);
+      rest -= piece.length;
+    }
+    const auto c = ctx.objects.clearance(q, horizon);
+    if (c.distance < best.distance) best = c;
+    if (best.distance < floor || s >= length) return best;
+    s += std::clamp((c.distance - floor) / lipschitz, 0.5 * kMinStep, 5.0 * kMaxStep);
+  }
+}
+
+// The partial path of one move: points every kOutputInterval at `speed` (signed), 0 at its end.
+PathWithLaneId move_points(const PlanningContext& ctx, const Move& m, double speed) {
+  PathWithLaneId seg;
+  const int n = std::max(1, static_cast<int>(std::ceil(m.length / kOutputInterval)));
+  const Polyline& center = ctx.road.centerline;
+  for (int i = 0; i <= n; ++i) {
+    PathPoint p;
+    p.pose = m.at(m.length * i / n);
+    p.longitudinal_velocity_mps = i == n ? 0.0 : speed;
+    p.lane_ids = lane_ids_at(ctx, to_vec(p.pose), road_lane_id_at(ctx, center.project(to_vec(p.pose)).s));
+    seg.points.push_back(std::move(p));
+  }
+  return seg;
+}
+
+}  // namespace
+
+PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, const Pose2& start,
+                                                    const StopCondition& stop) const {
+  const auto& p = ctx.parameters;
+  PlannerCandidates out;
+  if (p.geometric_pull_out_max_shunts <= 0) return out;
+  const auto fail = [&out](AttemptOutcome outcome, std::string detail) {
+    out.failure = Failure{outcome, "shunting: " + std::move(detail)};
+    return out;
+  };
+  const double steer = ctx.vehicle.max_steer_angle_rad * p.geometric_pull_out_max_steer_angle_margin_scale;
+  const double kappa = std::tan(steer) / ctx.vehicle.wheel_base_m;
+  const Polyline& center = ctx.road.centerline;
+  const auto on_road = center.project(to_vec(start));
+  const double side = on_road.lateral < 0.0 ? 1.0 : -1.0;  // +1: the road is to the left
+  const double limit = ctx.smallest_margin + kStopSlack;
+  // The moves' lane check: the footprint grown by lane_departure_check_expansion_margin (and 1 cm
+  // where the start has it).
+  Footprint lane_fp = vehicle_footprint(ctx.vehicle, p.lane_departure_check_expansion_margin + kLaneSlack);
+  if (!ctx.world.footprint_inside(footprint_corners(lane_fp, start))) {
+    lane_fp = vehicle_footprint(ctx.vehicle, p.lane_departure_check_expansion_margin);
+    if (!ctx.world.footprint_inside(footprint_corners(lane_fp, start))) {
+      return fail(AttemptOutcome::kLaneDeparture,
+                  "the start's footprint (with lane_departure_check_expansion_margin) leaves the lanes");
+    }
+  }
+
+  std::vector<Move> moves;
+  Pose2 pose = start;
+  const double r_min = 1.0 / kappa;
+  double Footprint::*const kerb_side = side > 0.0 ? &Footprint::right : &Footprint::left;
+  const auto tilt_at = [&](const Pose2& q) {
+    return side * normalize_angle(q.yaw - center.pose_at(center.project(to_vec(q)).s).yaw);
+  };
+  const auto add = [&](double k, double direction, double cap) {
+    Footprint fp = lane_fp;
+    if (direction < 0.0 && k != 0.0) {
+      // A reverse arc takes the rear towards the kerb; it leaves the room the next forward arc's
+      // rear corner swings out by (less as the vehicle turns further, so the start's tilt bounds
+      // it), where the start has that room.
+      fp.*kerb_side += corner_swing(r_min, fp.rear, fp.*kerb_side, kPi, std::max(0.0, tilt_at(pose)));
+      if (!ctx.world.footprint_inside(footprint_corners(fp, pose))) fp = lane_fp;
+    }
+    const MoveLimit lim = drive_until_clear(ctx, pose, k, direction, cap, fp, limit);
+    if (lim.length < kMinMove) return false;
+    moves.push_back({pose, k, direction, lim.length});
+    pose = moves.back().at(lim.length);
+    return true;
+  };
+  // 0. Straight back until just clear of what is behind.
+  if (ctx.max_back_distance > 0.0) add(0.0, -1.0, ctx.max_back_distance);
+
+  const double move_cap = kMaxMoveTurn / kappa;
+  std::optional<PathCandidate> exit;
+  std::string stuck;
+  for (int shunt = 0;; ++shunt) {
+    out.stopped = stop.check();
+    if (out.stopped != StopReason::kNone) return out;
+    // 1. The S from here.
+    std::vector<CurvaturePath> turn_paths;
+    PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, kInfinity, &turn_paths, moves.size() > 1);
+    for (std::size_t i = 0; i < s.candidates.size(); ++i) {
+      PathCandidate& c = s.candidates[i];
+      if (c.rejection || c.clearance < ctx.smallest_margin) continue;
+      // The S's own clearance samples every 0.5 m and refines around minima; from a tilted start
+      // the corners pass the cars within centimetres of the start, so it is taken densely here.
+      const CurvaturePath& turns = turn_paths[i];
+      const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kDenseSlack);
+      if (dense.distance < ctx.smallest_margin + kDenseSlack) continue;
+      exit = std::move(c);
+      break;
+    }
+    if (exit) break;
+    if (shunt >= p.geometric_pull_out_max_shunts) {
+      stuck = "no S onto the road after " + std::to_string(shunt) + " shunts";
+      break;
+    }
+    if (tilt_at(pose) > kMaxTilt) {
+      stuck = "turned across the road after " + std::to_string(shunt) + " shunts";
+      break;
+    }
+    // 2. Forward at full lock towards the road, reverse at full lock the other way.
+    if (!add(side * kappa, 1.0, move_cap)) {
+      stuck = "no room to move forward after " + std::to_string(shunt) + " shunts";
+      break;
+    }
+    // Where the rear has reached the kerb at full lock, straight back still makes room ahead (it
+    // takes the rear corner towards the kerb less than a reverse arc up to about 60 degrees).
+    if (!add(-side * kappa, -1.0, move_cap) && !add(0.0, -1.0, move_cap)) {
+      stuck = "no room to reverse after " + std::to_string(shunt) + " shunts and a forward move";
+      break;
+    }
+  }
+  if (!exit) return fail(AttemptOutcome::kNoGeometry, stuck);
+
+  // The moves' exact clearance (sampled while driving; the S's is the candidate's).
+  PathCandidate candidate;
+  candidate.clearance = exit->clearance;
+  candidate.nearest_obstacle = exit->nearest_obstacle;
+  for (const Move& m : moves) {
+    const auto c = dense_clearance(ctx, m.path(), m.length, ctx.smallest_margin + kDenseSlack);
+    if (c.distance < ctx.smallest_margin + kDenseSlack) {
+      // Closer than the smallest margin allows somewhere (dense_clearance stopped there).
+      candidate.rejection = Failure{AttemptOutcome::kCollision, "object " + std::to_string(c.obstacle_id) +
+                                                                    " closer than the smallest margin on a move"};
+      candidate.clearance = c.distance;
+      candidate.nearest_obstacle = c.obstacle_id;
+      break;
+    }
+    if (c.distance < candidate.clearance) {
+      candidate.clearance = c.distance;
+      candidate.nearest_obstacle = c.obstacle_id;
+    }
+  }
+  auto shared_moves = std::make_shared<const std::vector<Move>>(std::move(moves));
+  candidate.build = [&ctx, shared_moves, exit_build = exit->build, start]() {
+    const auto& prm = ctx.parameters;
+    PullOutPath path;
+    for (const Move& m : *shared_moves) {
+      // Cruise at what maximum_longitudinal_acc reaches over half the move (a = v^2 / L then
+      // brings it to a stop at the end).
+      const double cruise = m.direction > 0.0 ? prm.geometric_pull_out_velocity : ctx.reverse_speed;
+      const double v = std::min(cruise, std::sqrt(prm.maximum_longitudinal_acc * m.length));
+      path.partial_paths.push_back(move_points(ctx, m, m.direction * v));
+      path.pairs_terminal_velocity_and_accel.push_back({m.direction * v, m.direction * v * v / m.length});
+    }
+    PullOutPath s = exit_build();
+    for (auto& seg : s.partial_paths) path.partial_paths.push_back(std::move(seg));
+    for (const auto& pair : s.pairs_terminal_velocity_and_accel) path.pairs_terminal_velocity_and_accel.push_back(pair);
+    path.start_pose = start;
+    path.end_pose = s.end_pose;
+    path.shift_length_m = ctx.road.centerline.project(to_vec(start)).lateral;
+    return path;
+  };
+  out.candidates.push_back(std::move(candidate));
+  return out;
+}
+
+}  // namespace pullout
