@@ -38,10 +38,8 @@ int direction_of(const PathWithLaneId& seg) {
   return 0;
 }
 
-class FreespaceScenario : public ::testing::TestWithParam<const char*> {};
-
-TEST_P(FreespaceScenario, FindsADrivablePath) {
-  const Scenario sc = load(GetParam());
+// What every freespace path must be (the oracles in the file comment).
+void expect_drivable_freespace_path(const Scenario& sc) {
   const StartPlanner planner(sc.vehicle, sc.parameters);
   const PlanningResult r = planner.plan(sc.request, StopCondition::after_ms(5000));
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
@@ -145,10 +143,32 @@ TEST_P(FreespaceScenario, FindsADrivablePath) {
       EXPECT_LE(std::abs(kappa), k_max * 1.02) << "curvature, segment " << k << " point " << i;
     }
   }
-  RecordProperty("cusps", cusps);
+  ::testing::Test::RecordProperty("cusps", cusps);
+}
+
+class FreespaceScenario : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(FreespaceScenario, FindsADrivablePath) { expect_drivable_freespace_path(load(GetParam())); }
+
+// Autoware's freespace_planner_algorithm: rrtstar (informed RRT*, OMPL) through the same pipeline
+// and the same oracles.
+TEST_P(FreespaceScenario, RrtStarFindsADrivablePath) {
+  Scenario sc = load(GetParam());
+  sc.parameters.freespace_planner.freespace_planner_algorithm = "rrtstar";
+  sc.parameters.freespace_planner.time_limit = 20000.0;  // RRT* is slower; a generous bound, not a figure
+  expect_drivable_freespace_path(sc);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenarios, FreespaceScenario, ::testing::ValuesIn(kFreespaceScenarios));
+
+TEST(FreespacePullOut, UnknownAlgorithmIsNamedByTheCoreValidation) {
+  Scenario sc = load("freespace_parking_lot");
+  sc.parameters.freespace_planner.freespace_planner_algorithm = "bitstar";
+  const auto issues = validate_parameters(sc.parameters);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].name, "freespace_planner.freespace_planner_algorithm");
+  EXPECT_NE(issues[0].problem.find("'bitstar'"), std::string::npos) << issues[0].problem;
+}
 
 TEST(FreespacePullOut, LanePlannersAloneCannotLeaveTheBoxedInSpot) {
   Scenario sc = load("freespace_boxed_in");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/freespace/path_smoother.hpp"
@@ -34,6 +35,23 @@ void smooth_if_asked(const FreespaceParameters& p, const GridCollisionChecker& c
 }
 
 }  // namespace
+
+FreespaceSearch freespace_search(const FreespaceParameters& p, const FreespaceSearch& rrt_star) {
+  if (p.freespace_planner_algorithm == kRrtStarAlgorithm) {
+    if (!rrt_star) throw std::invalid_argument("freespace_planner_algorithm rrtstar: no RRT* search given");
+    return rrt_star;
+  }
+  if (p.freespace_planner_algorithm != kAstarAlgorithm) {
+    throw std::invalid_argument("freespace_planner_algorithm: unknown '" + p.freespace_planner_algorithm + "'");
+  }
+  return [](const GridCollisionChecker& checker, const HybridAStarConfig& config, const Pose2& start, const Pose2& goal,
+            const StopCondition& stop) { return HybridAStar(checker, config).plan(start, goal, stop); };
+}
+
+FreespacePullOut::FreespacePullOut(const FreespaceParameters& parameters, FreespaceSearch rrt_star)
+    : parameters_(parameters), rrt_star_(std::move(rrt_star)) {
+  freespace_search(parameters_, rrt_star_);  // the algorithm's name and its search, checked once
+}
 
 AttemptOutcome attempt_outcome(HybridAStarResult::Status status) {
   switch (status) {
@@ -178,11 +196,12 @@ SplitPath split_at_cusps(const std::vector<Waypoint>& w, double velocity) {
 
 FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const VehicleInfo& vehicle,
                                            const FreespaceParameters& p, const Pose2& start, const Pose2& goal,
-                                           const StopCondition& stop) {
+                                           const StopCondition& stop, const FreespaceSearch& rrt_star) {
   FreespaceGoalResult out;
   const GridCollisionChecker checker(costmap, freespace_footprint(vehicle, p));
   HybridAStarConfig config = freespace_search_config(vehicle, p);
-  const HybridAStarResult r = HybridAStar(checker, config).plan(start, goal, stop.with_budget_ms(p.time_limit));
+  const HybridAStarResult r =
+      freespace_search(p, rrt_star)(checker, config, start, goal, stop.with_budget_ms(p.time_limit));
   out.status = r.status;
   out.stopped = r.stopped;
   out.expansions = r.expansions;
@@ -219,7 +238,8 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
   out.stopped = costmap.stopped();
   if (out.stopped != StopReason::kNone) return out;
   const GridCollisionChecker checker(costmap, freespace_footprint(ctx.vehicle, p, costmap, start));
-  const HybridAStar search(checker, freespace_search_config(ctx.vehicle, p));
+  const HybridAStarConfig search_config = freespace_search_config(ctx.vehicle, p);
+  const FreespaceSearch search = freespace_search(p, rrt_star_);
 
   const Polyline& center = ctx.road.centerline;
   const double s_ego = center.project(to_vec(ctx.ego)).s;
@@ -231,7 +251,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
     out.stopped = until.check();
     if (out.stopped != StopReason::kNone) break;
     const Pose2 end_pose = center.pose_at(s_end);
-    HybridAStarResult r = search.plan(start, end_pose, until);
+    HybridAStarResult r = search(checker, search_config, start, end_pose, until);
     if (r.stopped != StopReason::kNone) {
       out.stopped = r.stopped;
       break;
@@ -242,7 +262,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
       if (r.status == HybridAStarResult::Status::kStartOccupied) break;  // the same for every end pose
       continue;
     }
-    smooth_if_asked(p, checker, search.config(), r.waypoints, until);
+    smooth_if_asked(p, checker, search_config, r.waypoints, until);
     PathCandidate candidate;
     std::vector<Pose2> poses;
     for (const Waypoint& w : r.waypoints) poses.push_back(w.pose);
