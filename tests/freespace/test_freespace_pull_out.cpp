@@ -42,7 +42,9 @@ int direction_of(const PathWithLaneId& seg) {
 void expect_drivable_freespace_path(const Scenario& sc) {
   const StartPlanner planner(sc.vehicle, sc.parameters);
   const PlanningResult r = planner.plan(sc.request, StopCondition::after_ms(5000));
-  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  std::string rows;
+  for (const auto& a : r.evaluation_table) rows += describe(a) + "; ";
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason << ": " << rows;
   const PullOutPath& path = r.path;
   EXPECT_EQ(path.planner_type, PlannerType::kFreespace);
   EXPECT_EQ(r.evaluation_table.back().planner, PlannerType::kFreespace);

@@ -54,6 +54,19 @@ class FreespacePullOut : public PullOutPlanner {
   FreespaceSearch rrt_star_;
 };
 
+// [m] With freespace_planner_algorithm rrtstar, FreespacePullOut grows the objects in its costmap
+// by this (the smallest of Autoware's default collision_check_margins): RRT*'s paths, shortest
+// between its samples, run along the obstacles, and the pipeline asks at least this clearance to
+// the objects of a path. Where the start is closer than that to an object (its footprint, with
+// the start-aware margin, collides), the objects are not grown. Hybrid A* searches the plain
+// costmap (its paths kept this clearance on every scenario, its figures are with it).
+constexpr double kRrtStarObjectClearance = 0.1;
+
+// Each polygon grown by `d` [m] on every side, conservatively: the convex hull of its vertices
+// moved by +-d in x and y (for a convex polygon a superset of the points within d of it; a
+// polygon that is not convex becomes its grown hull).
+std::vector<Polygon> grown_obstacles(const std::vector<Polygon>& obstacles, double d);
+
 // The search freespace_planner_algorithm names: hybrid A* for "astar", `rrt_star` for "rrtstar"
 // (std::invalid_argument when it is empty, or for another name).
 FreespaceSearch freespace_search(const FreespaceParameters& parameters, const FreespaceSearch& rrt_star);
