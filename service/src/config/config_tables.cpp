@@ -235,7 +235,7 @@ const Table<FreespaceParameters>& freespace_table() {
           field("enable_freespace_planner", &T::enable_freespace_planner, "", AnyValue{},
                 "fallback when the lane-based search finds nothing"),
           field("freespace_planner_algorithm", &T::freespace_planner_algorithm, "",
-                Choices{{kAstarAlgorithm, kRrtStarAlgorithm}}, "hybrid A* (astar) or informed RRT* (rrtstar, OMPL)"),
+                Choices{{kAstarAlgorithm, kRrtStarAlgorithm}}, "hybrid A* (astar) or seeded RRT* (rrtstar, OMPL)"),
           field("end_pose_search_start_distance", &T::end_pose_search_start_distance, "m", in(0.0, 500.0),
                 "end poses on the road centerline from s(ego) + this"),
           field("end_pose_search_end_distance", &T::end_pose_search_end_distance, "m", in(0.0, 500.0),

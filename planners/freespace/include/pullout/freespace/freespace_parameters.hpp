@@ -9,7 +9,7 @@ namespace pullout {
 
 struct FreespaceParameters {
   bool enable_freespace_planner{true};               // fallback when the lane-based search finds nothing
-  std::string freespace_planner_algorithm{"astar"};  // "astar" (hybrid A*) or "rrtstar" (informed RRT*)
+  std::string freespace_planner_algorithm{"astar"};  // "astar" (hybrid A*) or "rrtstar" (RRT*, freespace_ompl)
   double end_pose_search_start_distance{20.0};       // [m] end poses on the road centerline from s(ego) + this ...
   double end_pose_search_end_distance{30.0};         // [m] ... to s(ego) + this
   double end_pose_search_interval{2.0};              // [m] spacing of the end poses

@@ -1,5 +1,5 @@
 // The freespace search behind freespace_planner.freespace_planner_algorithm (Autoware's key):
-// "astar" is hybrid A* (hybrid_astar.hpp, this module); "rrtstar" is an informed RRT* that lives
+// "astar" is hybrid A* (hybrid_astar.hpp, this module); "rrtstar" is OMPL's RRT*, seeded and retried, that lives
 // in its own module (freespace_ompl: OMPL stays out of this one) and is handed in as a
 // FreespaceSearch by whoever builds the planner (the pipeline). Both answer with the same result
 // (waypoints with their driving direction), so everything after the search is shared.
