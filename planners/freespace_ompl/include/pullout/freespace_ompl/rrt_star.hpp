@@ -16,7 +16,8 @@
 // Deterministic: every random number of a search comes from generators seeded here, per search
 // (ompl::RNG::setLocalSeed on the planner's and the sampler's own generators; OMPL's process-wide
 // seed, ompl::RNG::setSeed, is neither used nor needed), and the nearest-neighbour structure is
-// one without randomness (OMPL's default GNAT draws its pivots from a generator of its own). Each
+// one without randomness (OMPL's default GNAT draws its pivots from a generator that takes its seed from the
+// process-wide sequence). Each
 // attempt is bounded by a number of iterations, not by time: the same request gives the same
 // path whatever ran before it in the process, in any thread, and however loaded the machine is,
 // as long as `stop` does not cut the search short.
@@ -34,6 +35,10 @@
 // Output: the same as HybridAStar::plan (waypoints with their direction, at most
 // config.waypoint_interval apart, every cusp a waypoint; length). Start or goal in collision:
 // kStartOccupied / kGoalOccupied.
+//
+// Cost: motions of at most two turning radii; an iteration costs more as the tree grows (the
+// k-nearest query of OMPL's SqrtApprox is linear in it): hundreds of milliseconds to seconds
+// where hybrid A* takes milliseconds (bench/RESULTS.md).
 //
 // Thread safety: a call owns all its OMPL objects. OMPL's console output is switched off (once).
 #pragma once
