@@ -3,7 +3,7 @@
 //
 //   build/bench/bench_freespace [--problems 24] [--budget-ms 2000] [--seed 5] [--heuristic-weight 2.0]
 //                               [--theta-size N] [--xy-resolution M] [--narrow-penalty P] [--turning-steps S]
-//                               [--ours-only]
+//                               [--ours-only] [--no-peers]
 //
 //   build/bench/bench_freespace --tpcap ../shared/benchmarks/tpcap [--resolution 0.1] [--budget-ms 10000]
 //                               [--case N] [--min-primitive M] [--search-from-goal]
@@ -12,6 +12,9 @@
 // the generated lots: the organisers' vehicle (no shape margin), turning radius from wheelbase
 // 2.8 m and steering 0.75 rad, the map the organisers' demo draws (start and goal box +-15 m),
 // the obstacle polygons exact (Costmap::from_polygons).
+// Ours twice: freespace_planner_algorithm astar (hybrid A*) and rrtstar (freespace_ompl's seeded,
+// retried RRT*, run_rrt_star). --no-peers skips the OMPL RRT*/BIT* peers (plain OMPL, seeded by
+// the process-wide ompl::RNG::setSeed).
 // --ours-only skips OMPL and prints the expansions of each search. With the environment variable
 // PULLOUT_DUMP_EXPANSIONS=<dir>, each problem's costmap (<i>.pgm) and the poses our search expanded
 // (<i>.txt: "E x y yaw" lines) are written there, to see where a search spends its time.
@@ -48,12 +51,14 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
+#include "load_average.hpp"
 #include "lot_shapes.hpp"
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/freespace/hybrid_astar.hpp"
 #include "pullout/freespace/path_smoother.hpp"
 #include "pullout/freespace/reeds_shepp.hpp"
+#include "pullout/freespace_ompl/rrt_star.hpp"
 #include "pullout/geometry/angle.hpp"
 #include "pullout/vehicle/vehicle_info.hpp"
 #include "tpcap.hpp"
@@ -248,6 +253,25 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   return run;
 }
 
+// Ours with freespace_planner_algorithm rrtstar (freespace_ompl/rrt_star.hpp: seeded, retried),
+// the same checker and budget; no smoothing (time to the search's answer, as for the others).
+Run run_rrtstar(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms) {
+  pullout::HybridAStarConfig config;
+  config.turning_radius = radius;
+  const auto t0 = std::chrono::steady_clock::now();
+  const pullout::RrtStarResult r = pullout::run_rrt_star(checker, config, pullout::RrtStarConfig{}, p.start, p.goal,
+                                                         pullout::StopCondition::after_ms(budget_ms));
+  Run run;
+  run.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  run.success = r.search.status == pullout::HybridAStarResult::Status::kSuccess;
+  run.length = r.search.length;
+  run.expansions = r.search.expansions;
+  run.status = static_cast<int>(r.search.status);
+  const auto& w = r.search.waypoints;
+  for (std::size_t i = 1; i < w.size(); ++i) run.direction_changes += w[i].direction != w[i - 1].direction ? 1 : 0;
+  return run;
+}
+
 // Ours before and after smoothing (path_smoother.hpp), over the solved problems.
 void print_smoothing(const std::vector<Run>& runs) {
   std::vector<double> times;
@@ -395,6 +419,7 @@ int main(int argc, char** argv) {
   unsigned seed = 5;
   double heuristic_weight = 2.0;  // astar.distance_heuristic_weight (its default)
   bool ours_only = false;         // --ours-only: skip OMPL, print search statistics
+  bool no_peers = false;          // --no-peers: hybrid A* and rrtstar only (no OMPL RRT*/BIT* peers)
   std::string tpcap;              // --tpcap DIR: the TPCAP cases instead of generated lots
   double tpcap_resolution = 0.1;  // [m]
   int only_case = 0;              // --case N: this TPCAP case only (1-based)
@@ -402,6 +427,8 @@ int main(int argc, char** argv) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(argv[i], "--ours-only") == 0) {
       ours_only = true;
+    } else if (std::strcmp(argv[i], "--no-peers") == 0) {
+      no_peers = true;
     } else if (has_value && std::strcmp(argv[i], "--tpcap") == 0) {
       tpcap = argv[++i];
     } else if (std::strcmp(argv[i], "--search-from-goal") == 0) {
@@ -445,10 +472,11 @@ int main(int argc, char** argv) {
           pullout::bench::kTpcapHalfWidth};
   }
   std::mt19937 rng(seed);
-  const char* names[3] = {"hybrid A* (pullout)", "OMPL RRT*", "OMPL BIT*"};
-  std::vector<Run> runs[3];
+  constexpr int kPlanners = 4;
+  const char* names[kPlanners] = {"astar (pullout)", "rrtstar (pullout)", "OMPL RRT*", "OMPL BIT*"};
+  std::vector<Run> runs[kPlanners];
   std::vector<double> small_ours;  // 30 m at 0.2 m
-  std::printf("%-18s %28s %28s %28s\n", "problem", names[0], names[1], names[2]);
+  std::printf("%-18s %28s %28s %28s %28s\n", "problem", names[0], names[1], names[2], names[3]);
   for (int i = 0; i < problems; ++i) {
     Problem p;
     if (!tpcap.empty() && only_case > 0 && i + 1 != only_case) continue;
@@ -477,10 +505,14 @@ int main(int argc, char** argv) {
       if (p.size == 30.0 && p.resolution > 0.15 && r.success) small_ours.push_back(r.time_ms);
       continue;
     }
-    const Run r[3] = {run_ours(p, checker, radius, budget_ms, heuristic_weight),
-                      run_ompl(p, checker, radius, budget_ms, false), run_ompl(p, checker, radius, budget_ms, true)};
+    Run r[kPlanners] = {run_ours(p, checker, radius, budget_ms, heuristic_weight),
+                        run_rrtstar(p, checker, radius, budget_ms), Run{}, Run{}};
+    if (!no_peers) {
+      r[2] = run_ompl(p, checker, radius, budget_ms, false);
+      r[3] = run_ompl(p, checker, radius, budget_ms, true);
+    }
     std::printf("%-18s", p.name.c_str());
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < (no_peers ? 2 : kPlanners); ++k) {
       runs[k].push_back(r[k]);
       if (r[k].success) {
         std::printf("   %8.1f ms %6.1f m %2d cusps", r[k].time_ms, r[k].length, r[k].direction_changes);
@@ -507,7 +539,7 @@ int main(int argc, char** argv) {
       "\n| planner | success | median time to first solution [ms] | p95 [ms] | median over successes [ms] | mean "
       "length [m] | mean direction changes |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
-  for (int k = 0; k < (ours_only ? 1 : 3); ++k) {
+  for (int k = 0; k < (ours_only ? 1 : no_peers ? 2 : kPlanners); ++k) {
     std::vector<double> all, solved;
     double len = 0.0, changes = 0.0;
     for (const Run& r : runs[k]) {
@@ -522,6 +554,7 @@ int main(int argc, char** argv) {
                 fmt(percentile(all, 0.5)).c_str(), fmt(percentile(all, 0.95)).c_str(),
                 fmt(percentile(solved, 0.5)).c_str(), len / n, changes / n);
   }
+  std::printf("\nload average at the end: %s\n", pullout::bench::load_text().c_str());
   std::printf("\nhybrid A* median on 30 m x 30 m at 0.2 m: %.1f ms (%zu problems)\n", percentile(small_ours, 0.5),
               small_ours.size());
   print_smoothing(runs[0]);

@@ -16,6 +16,8 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/config/scenario.hpp"
+#include "pullout/geometry/angle.hpp"
+#include "pullout/geometry/polygon.hpp"
 #include "pullout/geometry/polyline.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
@@ -38,13 +40,14 @@ int direction_of(const PathWithLaneId& seg) {
   return 0;
 }
 
-class FreespaceScenario : public ::testing::TestWithParam<const char*> {};
-
-TEST_P(FreespaceScenario, FindsADrivablePath) {
-  const Scenario sc = load(GetParam());
+// What every freespace path must be (the oracles in the file comment).
+// `deadline_ms` is a generous bound, not a figure.
+void expect_drivable_freespace_path(const Scenario& sc, double deadline_ms = 5000.0) {
   const StartPlanner planner(sc.vehicle, sc.parameters);
-  const PlanningResult r = planner.plan(sc.request, StopCondition::after_ms(5000));
-  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  const PlanningResult r = planner.plan(sc.request, StopCondition::after_ms(deadline_ms));
+  std::string rows;
+  for (const auto& a : r.evaluation_table) rows += describe(a) + "; ";
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason << ": " << rows;
   const PullOutPath& path = r.path;
   EXPECT_EQ(path.planner_type, PlannerType::kFreespace);
   EXPECT_EQ(r.evaluation_table.back().planner, PlannerType::kFreespace);
@@ -145,10 +148,80 @@ TEST_P(FreespaceScenario, FindsADrivablePath) {
       EXPECT_LE(std::abs(kappa), k_max * 1.02) << "curvature, segment " << k << " point " << i;
     }
   }
-  RecordProperty("cusps", cusps);
+  ::testing::Test::RecordProperty("cusps", cusps);
+}
+
+class FreespaceScenario : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(FreespaceScenario, FindsADrivablePath) { expect_drivable_freespace_path(load(GetParam())); }
+
+// Autoware's freespace_planner_algorithm: rrtstar (seeded RRT*, OMPL) through the same pipeline
+// and the same oracles.
+TEST_P(FreespaceScenario, RrtStarFindsADrivablePath) {
+  Scenario sc = load(GetParam());
+  sc.parameters.freespace_planner.freespace_planner_algorithm = "rrtstar";
+  // RRT*'s work is bounded by its iterations (rrt_star.hpp): these bounds, far above the time it
+  // takes (a few hundred ms), only keep a loaded or sanitized run from cutting it short.
+  sc.parameters.freespace_planner.time_limit = 60000.0;
+  expect_drivable_freespace_path(sc, 60000.0);
+}
+
+// Deterministic through the pipeline: the same request planned twice, another rrtstar request in
+// between, gives the same path point for point (the first version drew OMPL's process-wide seed).
+TEST_P(FreespaceScenario, RrtStarGivesTheSamePathEveryTime) {
+  Scenario sc = load(GetParam());
+  sc.parameters.freespace_planner.freespace_planner_algorithm = "rrtstar";
+  sc.parameters.freespace_planner.time_limit = 60000.0;
+  const StartPlanner planner(sc.vehicle, sc.parameters);
+  const PlanningResult first = planner.plan(sc.request, StopCondition::after_ms(60000));
+  ASSERT_EQ(first.outcome, PlanningResult::Outcome::kFound) << first.stop_reason;
+  Scenario other =
+      load(std::string(GetParam()) == "freespace_parking_lot" ? "freespace_kerb" : "freespace_parking_lot");
+  other.parameters.freespace_planner.freespace_planner_algorithm = "rrtstar";
+  other.parameters.freespace_planner.time_limit = 60000.0;
+  (void)StartPlanner(other.vehicle, other.parameters).plan(other.request, StopCondition::after_ms(60000));
+  const PlanningResult again = planner.plan(sc.request, StopCondition::after_ms(60000));
+  ASSERT_EQ(again.outcome, PlanningResult::Outcome::kFound) << again.stop_reason;
+  ASSERT_EQ(first.path.partial_paths.size(), again.path.partial_paths.size());
+  for (std::size_t k = 0; k < first.path.partial_paths.size(); ++k) {
+    const auto& a = first.path.partial_paths[k].points;
+    const auto& b = again.path.partial_paths[k].points;
+    ASSERT_EQ(a.size(), b.size()) << k;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].pose.x, b[i].pose.x) << k << " " << i;
+      EXPECT_EQ(a[i].pose.y, b[i].pose.y) << k << " " << i;
+      EXPECT_EQ(a[i].longitudinal_velocity_mps, b[i].longitudinal_velocity_mps) << k << " " << i;
+    }
+  }
+}
+
+// The objects rrtstar's costmap grows (freespace_pull_out.hpp): a 1 m square grown by 0.1 m is
+// the 1.2 m square around it (the hull of the vertices moved by +-0.1), a superset of the points
+// within 0.1 m.
+TEST(FreespacePullOut, GrownObstaclesHoldEveryPointWithinTheGrowth) {
+  const Polygon square{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const std::vector<Polygon> grown = grown_obstacles({square}, 0.1);
+  ASSERT_EQ(grown.size(), 1u);
+  EXPECT_NEAR(std::abs(signed_area(grown[0])), 1.2 * 1.2, 1e-12);
+  for (int i = 0; i < 72; ++i) {
+    const double a = i * kPi / 36;
+    for (const Vec2& corner : square) {
+      EXPECT_TRUE(point_in_polygon(grown[0], corner + 0.0999 * Vec2(std::cos(a), std::sin(a)))) << i;
+    }
+  }
+  EXPECT_FALSE(point_in_polygon(grown[0], {1.15, 0.5}));
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenarios, FreespaceScenario, ::testing::ValuesIn(kFreespaceScenarios));
+
+TEST(FreespacePullOut, UnknownAlgorithmIsNamedByTheCoreValidation) {
+  Scenario sc = load("freespace_parking_lot");
+  sc.parameters.freespace_planner.freespace_planner_algorithm = "bitstar";
+  const auto issues = validate_parameters(sc.parameters);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].name, "freespace_planner.freespace_planner_algorithm");
+  EXPECT_NE(issues[0].problem.find("'bitstar'"), std::string::npos) << issues[0].problem;
+}
 
 TEST(FreespacePullOut, LanePlannersAloneCannotLeaveTheBoxedInSpot) {
   Scenario sc = load("freespace_boxed_in");

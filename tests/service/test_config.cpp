@@ -258,6 +258,19 @@ TEST(Config, ProblemLinesCarryTheFileAndLine) {
   }
 }
 
+TEST(Config, FreespaceAlgorithmIsAutowaresKey) {
+  ConfigFile rrt(std::string(kMinimal) +
+                 "start_planner:\n  freespace_planner:\n    freespace_planner_algorithm: rrtstar\n");
+  EXPECT_EQ(load_config(rrt.path()).start_planner.freespace_planner.freespace_planner_algorithm, "rrtstar");
+  EXPECT_EQ(Config{}.start_planner.freespace_planner.freespace_planner_algorithm, "astar");
+  const auto p = problems_of(std::string(kMinimal) +
+                             "start_planner:\n  freespace_planner:\n    freespace_planner_algorithm: dijkstra\n");
+  ASSERT_EQ(p.size(), 1u) << dump(p);
+  EXPECT_TRUE(
+      any_starts_with(p, "start_planner.freespace_planner.freespace_planner_algorithm: unknown value 'dijkstra'"))
+      << dump(p);
+}
+
 TEST(Config, OutOfRangeIsNamed) {
   const auto p = problems_of(
       "vehicle: {max_steer_angle: 2.0}\n"
@@ -341,14 +354,13 @@ TEST(Config, FreespaceKeysAreReadAndChecked) {
                              "start_planner:\n  freespace_planner:\n    time_limit: -1\n"
                              "    end_pose_search_start_distance: 30\n    end_pose_search_end_distance: 20\n"
                              "    search_configs: {theta_size: 3, bogus: 1}\n"
-                             "    freespace_planner_algorithm: rrtstar\n");
+                             "    rrtstar: {enable_update: true}\n");
   EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.time_limit: must be in")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.end_pose_search_end_distance: must be >="))
       << dump(p);
   EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.search_configs.theta_size: must be in")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.search_configs.bogus: unknown key")) << dump(p);
-  EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.freespace_planner_algorithm: Autoware parameter"))
-      << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "start_planner.freespace_planner.rrtstar: Autoware parameter")) << dump(p);
   EXPECT_EQ(p.size(), 5u) << dump(p);
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/freespace/path_smoother.hpp"
@@ -33,7 +34,60 @@ void smooth_if_asked(const FreespaceParameters& p, const GridCollisionChecker& c
   waypoints = smooth_path(waypoints, checker, config, stop).waypoints;
 }
 
+// Andrew's monotone chain: the convex hull of `points`, counter-clockwise.
+Polygon convex_hull(std::vector<Vec2> points) {
+  std::sort(points.begin(), points.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  if (points.size() < 3) return points;
+  const auto cross = [](const Vec2& o, const Vec2& a, const Vec2& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  Polygon hull(2 * points.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
 }  // namespace
+
+std::vector<Polygon> grown_obstacles(const std::vector<Polygon>& obstacles, double d) {
+  std::vector<Polygon> out;
+  out.reserve(obstacles.size());
+  for (const Polygon& o : obstacles) {
+    std::vector<Vec2> moved;
+    moved.reserve(4 * o.size());
+    for (const Vec2& v : o) {
+      for (const Vec2& m : {Vec2(d, d), Vec2(d, -d), Vec2(-d, d), Vec2(-d, -d)}) moved.push_back(v + m);
+    }
+    out.push_back(convex_hull(std::move(moved)));
+  }
+  return out;
+}
+
+FreespaceSearch freespace_search(const FreespaceParameters& p, const FreespaceSearch& rrt_star) {
+  if (p.freespace_planner_algorithm == kRrtStarAlgorithm) {
+    if (!rrt_star) throw std::invalid_argument("freespace_planner_algorithm rrtstar: no RRT* search given");
+    return rrt_star;
+  }
+  if (p.freespace_planner_algorithm != kAstarAlgorithm) {
+    throw std::invalid_argument("freespace_planner_algorithm: unknown '" + p.freespace_planner_algorithm + "'");
+  }
+  return [](const GridCollisionChecker& checker, const HybridAStarConfig& config, const Pose2& start, const Pose2& goal,
+            const StopCondition& stop) { return HybridAStar(checker, config).plan(start, goal, stop); };
+}
+
+FreespacePullOut::FreespacePullOut(const FreespaceParameters& parameters, FreespaceSearch rrt_star)
+    : parameters_(parameters), rrt_star_(std::move(rrt_star)) {
+  freespace_search(parameters_, rrt_star_);  // the algorithm's name and its search, checked once
+}
 
 AttemptOutcome attempt_outcome(HybridAStarResult::Status status) {
   switch (status) {
@@ -178,11 +232,12 @@ SplitPath split_at_cusps(const std::vector<Waypoint>& w, double velocity) {
 
 FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const VehicleInfo& vehicle,
                                            const FreespaceParameters& p, const Pose2& start, const Pose2& goal,
-                                           const StopCondition& stop) {
+                                           const StopCondition& stop, const FreespaceSearch& rrt_star) {
   FreespaceGoalResult out;
   const GridCollisionChecker checker(costmap, freespace_footprint(vehicle, p));
   HybridAStarConfig config = freespace_search_config(vehicle, p);
-  const HybridAStarResult r = HybridAStar(checker, config).plan(start, goal, stop.with_budget_ms(p.time_limit));
+  const HybridAStarResult r =
+      freespace_search(p, rrt_star)(checker, config, start, goal, stop.with_budget_ms(p.time_limit));
   out.status = r.status;
   out.stopped = r.stopped;
   out.expansions = r.expansions;
@@ -215,11 +270,21 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
   const std::vector<Polygon>& obstacles = ctx.obstacle_polygons != nullptr ? *ctx.obstacle_polygons : no_obstacles;
   const double half_window = freespace_window_half_size(p, ctx.vehicle);
   // The costmap and the search are shared by every end pose; heavy, so built once, within `until`.
-  const Costmap costmap = freespace_costmap(p, ctx.occupancy_grid, &ctx.world, obstacles, ctx.ego, half_window, until);
+  // RRT* gets the objects grown by kRrtStarObjectClearance where the start allows (see the header).
+  const bool grow = p.freespace_planner_algorithm == kRrtStarAlgorithm && !obstacles.empty();
+  Costmap costmap = freespace_costmap(p, ctx.occupancy_grid, &ctx.world,
+                                      grow ? grown_obstacles(obstacles, kRrtStarObjectClearance) : obstacles, ctx.ego,
+                                      half_window, until);
   out.stopped = costmap.stopped();
   if (out.stopped != StopReason::kNone) return out;
+  if (grow && GridCollisionChecker(costmap, freespace_footprint(ctx.vehicle, p, costmap, start)).collides(start)) {
+    costmap = freespace_costmap(p, ctx.occupancy_grid, &ctx.world, obstacles, ctx.ego, half_window, until);
+    out.stopped = costmap.stopped();
+    if (out.stopped != StopReason::kNone) return out;
+  }
   const GridCollisionChecker checker(costmap, freespace_footprint(ctx.vehicle, p, costmap, start));
-  const HybridAStar search(checker, freespace_search_config(ctx.vehicle, p));
+  const HybridAStarConfig search_config = freespace_search_config(ctx.vehicle, p);
+  const FreespaceSearch search = freespace_search(p, rrt_star_);
 
   const Polyline& center = ctx.road.centerline;
   const double s_ego = center.project(to_vec(ctx.ego)).s;
@@ -231,7 +296,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
     out.stopped = until.check();
     if (out.stopped != StopReason::kNone) break;
     const Pose2 end_pose = center.pose_at(s_end);
-    HybridAStarResult r = search.plan(start, end_pose, until);
+    HybridAStarResult r = search(checker, search_config, start, end_pose, until);
     if (r.stopped != StopReason::kNone) {
       out.stopped = r.stopped;
       break;
@@ -242,7 +307,7 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
       if (r.status == HybridAStarResult::Status::kStartOccupied) break;  // the same for every end pose
       continue;
     }
-    smooth_if_asked(p, checker, search.config(), r.waypoints, until);
+    smooth_if_asked(p, checker, search_config, r.waypoints, until);
     PathCandidate candidate;
     std::vector<Pose2> poses;
     for (const Waypoint& w : r.waypoints) poses.push_back(w.pose);

@@ -3,6 +3,8 @@
 // tables (service/src/config/config_tables.cpp), which check them when a file is read.
 #include "pullout/pipeline/parameters.hpp"
 
+#include "pullout/freespace/freespace_search.hpp"
+
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -54,6 +56,10 @@ std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p)
     fail("freespace_planner.end_pose_search_end_distance", "must be >= end_pose_search_start_distance (" +
                                                                text(f.end_pose_search_start_distance) + "), got " +
                                                                text(f.end_pose_search_end_distance));
+  }
+  if (f.freespace_planner_algorithm != kAstarAlgorithm && f.freespace_planner_algorithm != kRrtStarAlgorithm) {
+    fail("freespace_planner.freespace_planner_algorithm",
+         "must be astar or rrtstar, got '" + f.freespace_planner_algorithm + "'");
   }
   return issues;
 }

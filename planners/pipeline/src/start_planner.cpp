@@ -10,6 +10,7 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/freespace/freespace_pull_out.hpp"
+#include "pullout/freespace_ompl/rrt_star.hpp"
 #include "pullout/lane_planners/clothoid_pull_out.hpp"
 #include "pullout/lane_planners/geometric_pull_out.hpp"
 #include "pullout/lane_planners/shift_pull_out.hpp"
@@ -159,7 +160,7 @@ std::unique_ptr<PullOutPlanner> make_planner(PlannerType type, const StartPlanne
     case PlannerType::kClothoid:
       return std::make_unique<ClothoidPullOut>();
     case PlannerType::kFreespace:
-      return std::make_unique<FreespacePullOut>(parameters.freespace_planner);
+      return std::make_unique<FreespacePullOut>(parameters.freespace_planner, &plan_rrt_star);
     default:
       return nullptr;
   }
@@ -376,7 +377,7 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
     r.status = r.stopped == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
                                                    : HybridAStarResult::Status::kTimeout;
   } else {
-    r = plan_freespace_to_goal(costmap, vehicle, p, request.ego_pose, request.goal_pose, stop);
+    r = plan_freespace_to_goal(costmap, vehicle, p, request.ego_pose, request.goal_pose, stop, &plan_rrt_star);
   }
   const double margin = 0.5 * p.vehicle_shape_margin;
   const Failure f =
@@ -624,7 +625,8 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   const bool freespace_listed = std::find(params.search_priority.begin(), params.search_priority.end(),
                                           PlannerType::kFreespace) != params.search_priority.end();
   if (params.freespace_planner.enable_freespace_planner && !freespace_listed && result.stopped == StopReason::kNone) {
-    const PlannerCandidates fallback = FreespacePullOut(params.freespace_planner).plan(context, request.ego_pose, stop);
+    const PlannerCandidates fallback =
+        FreespacePullOut(params.freespace_planner, &plan_rrt_star).plan(context, request.ego_pose, stop);
     if (fallback.stopped == StopReason::kDeadline || fallback.stopped == StopReason::kCancelled) {
       result.stopped = fallback.stopped;
     }

@@ -15,6 +15,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "config/config_table.hpp"
+#include "pullout/freespace/freespace_search.hpp"
 
 namespace pullout::config_table {
 namespace {
@@ -35,15 +36,13 @@ const char* start_planner_hint(const std::string& key) {
                                                                  : nullptr;
 }
 
-// Autoware freespace_planner keys this version does not implement (the A* is the only algorithm).
+// Autoware freespace_planner keys this version does not implement (the rrtstar group: RRT* runs
+// with its first solution, see freespace_ompl/rrt_star.hpp).
 const char* freespace_hint(const std::string& key) {
-  static constexpr std::array<std::string_view, 6> kAutowareOnly{
-      "freespace_planner_algorithm", "rrtstar",
-      "minimum_turning_radius",      "maximum_turning_radius",
-      "turning_radius_size",         "only_behind_solutions"};
-  return listed(key, kAutowareOnly.begin(), kAutowareOnly.end())
-             ? "Autoware parameter not supported in this version (hybrid A* only)"
-             : nullptr;
+  static constexpr std::array<std::string_view, 5> kAutowareOnly{
+      "rrtstar", "minimum_turning_radius", "maximum_turning_radius", "turning_radius_size", "only_behind_solutions"};
+  return listed(key, kAutowareOnly.begin(), kAutowareOnly.end()) ? "Autoware parameter not supported in this version"
+                                                                 : nullptr;
 }
 
 // Autoware safety-check keys with no meaning here (lanes this version does not model).
@@ -231,30 +230,33 @@ const Table<FreespaceParameters::Astar>& astar_table() {
 
 const Table<FreespaceParameters>& freespace_table() {
   using T = FreespaceParameters;
-  static const Table<T> t{{
-                              field("enable_freespace_planner", &T::enable_freespace_planner, "", AnyValue{},
-                                    "fallback when the lane-based search finds nothing"),
-                              field("end_pose_search_start_distance", &T::end_pose_search_start_distance, "m",
-                                    in(0.0, 500.0), "end poses on the road centerline from s(ego) + this"),
-                              field("end_pose_search_end_distance", &T::end_pose_search_end_distance, "m",
-                                    in(0.0, 500.0), "... to s(ego) + this, >= the start distance"),
-                              field("end_pose_search_interval", &T::end_pose_search_interval, "m", in(0.1, 100.0),
-                                    "spacing of the end poses"),
-                              field("velocity", &T::velocity, "m/s", in(0.01, 20.0), "speed on the freespace path"),
-                              field("vehicle_shape_margin", &T::vehicle_shape_margin, "m", in(0.0, 5.0),
-                                    "added to the vehicle length and width"),
-                              field("time_limit", &T::time_limit, "ms", in(1.0, 60000.0),
-                                    "search budget; the request deadline may cut it shorter"),
-                              field("max_turning_ratio", &T::max_turning_ratio, "", in(0.05, 1.0),
-                                    "x vehicle.max_steer_angle for the motion primitives"),
-                              field("turning_steps", &T::turning_steps, "", in(1, 10), "steering angles per side"),
-                              field("smooth_path", &T::smooth_path, "", AnyValue{},
-                                    "(not Autoware) smooth each direction segment, cusps kept"),
-                              group("search_configs", &T::search_configs, &search_configs_table, ""),
-                              group("costmap_configs", &T::costmap_configs, &costmap_configs_table, ""),
-                              group("astar", &T::astar, &astar_table, ""),
-                          },
-                          &freespace_hint};
+  static const Table<T> t{
+      {
+          field("enable_freespace_planner", &T::enable_freespace_planner, "", AnyValue{},
+                "fallback when the lane-based search finds nothing"),
+          field("freespace_planner_algorithm", &T::freespace_planner_algorithm, "",
+                Choices{{kAstarAlgorithm, kRrtStarAlgorithm}}, "hybrid A* (astar) or seeded RRT* (rrtstar, OMPL)"),
+          field("end_pose_search_start_distance", &T::end_pose_search_start_distance, "m", in(0.0, 500.0),
+                "end poses on the road centerline from s(ego) + this"),
+          field("end_pose_search_end_distance", &T::end_pose_search_end_distance, "m", in(0.0, 500.0),
+                "... to s(ego) + this, >= the start distance"),
+          field("end_pose_search_interval", &T::end_pose_search_interval, "m", in(0.1, 100.0),
+                "spacing of the end poses"),
+          field("velocity", &T::velocity, "m/s", in(0.01, 20.0), "speed on the freespace path"),
+          field("vehicle_shape_margin", &T::vehicle_shape_margin, "m", in(0.0, 5.0),
+                "added to the vehicle length and width"),
+          field("time_limit", &T::time_limit, "ms", in(1.0, 60000.0),
+                "search budget; the request deadline may cut it shorter"),
+          field("max_turning_ratio", &T::max_turning_ratio, "", in(0.05, 1.0),
+                "x vehicle.max_steer_angle for the motion primitives"),
+          field("turning_steps", &T::turning_steps, "", in(1, 10), "steering angles per side"),
+          field("smooth_path", &T::smooth_path, "", AnyValue{},
+                "(not Autoware) smooth each direction segment, cusps kept"),
+          group("search_configs", &T::search_configs, &search_configs_table, ""),
+          group("costmap_configs", &T::costmap_configs, &costmap_configs_table, ""),
+          group("astar", &T::astar, &astar_table, ""),
+      },
+      &freespace_hint};
   return t;
 }
 

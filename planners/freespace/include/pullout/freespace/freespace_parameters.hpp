@@ -3,18 +3,21 @@
 // every key here is used. Validated by validate_parameters().
 #pragma once
 
+#include <string>
+
 namespace pullout {
 
 struct FreespaceParameters {
-  bool enable_freespace_planner{true};          // fallback when the lane-based search finds nothing
-  double end_pose_search_start_distance{20.0};  // [m] end poses on the road centerline from s(ego) + this ...
-  double end_pose_search_end_distance{30.0};    // [m] ... to s(ego) + this
-  double end_pose_search_interval{2.0};         // [m] spacing of the end poses
-  double velocity{1.0};                         // [m/s] speed on the freespace path
-  double vehicle_shape_margin{1.0};             // [m] added to the vehicle's length and width (half each side)
-  double time_limit{3000.0};                    // [ms] search budget (the request deadline may cut it shorter)
-  double max_turning_ratio{0.7};                // x max_steer_angle for the primitives (0, 1]
-  int turning_steps{1};                         // steering angles per side
+  bool enable_freespace_planner{true};               // fallback when the lane-based search finds nothing
+  std::string freespace_planner_algorithm{"astar"};  // "astar" (hybrid A*) or "rrtstar" (RRT*, freespace_ompl)
+  double end_pose_search_start_distance{20.0};       // [m] end poses on the road centerline from s(ego) + this ...
+  double end_pose_search_end_distance{30.0};         // [m] ... to s(ego) + this
+  double end_pose_search_interval{2.0};              // [m] spacing of the end poses
+  double velocity{1.0};                              // [m/s] speed on the freespace path
+  double vehicle_shape_margin{1.0};                  // [m] added to the vehicle's length and width (half each side)
+  double time_limit{3000.0};                         // [ms] search budget (the request deadline may cut it shorter)
+  double max_turning_ratio{0.7};                     // x max_steer_angle for the primitives (0, 1]
+  int turning_steps{1};                              // steering angles per side
   // Not in Autoware: smooth each direction segment of the path, cusps kept (path_smoother.hpp).
   bool smooth_path{true};
   struct SearchConfigs {

@@ -33,6 +33,7 @@
 
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/freespace_parameters.hpp"
+#include "pullout/freespace/freespace_search.hpp"
 #include "pullout/freespace/hybrid_astar.hpp"
 #include "pullout/lane_planners/pull_out_planner.hpp"
 
@@ -40,7 +41,9 @@ namespace pullout {
 
 class FreespacePullOut : public PullOutPlanner {
  public:
-  explicit FreespacePullOut(const FreespaceParameters& parameters) : parameters_(parameters) {}
+  // `rrt_star`: the search of freespace_planner_algorithm "rrtstar" (freespace_ompl's
+  // plan_rrt_star); std::invalid_argument when that algorithm is asked for without it.
+  explicit FreespacePullOut(const FreespaceParameters& parameters, FreespaceSearch rrt_star = {});
   PlannerType type() const override { return PlannerType::kFreespace; }
   // One candidate at most. Plans from the current pose only (context.ego): a backward start
   // candidate gets a failure, the search itself reverses where needed.
@@ -48,7 +51,25 @@ class FreespacePullOut : public PullOutPlanner {
 
  private:
   FreespaceParameters parameters_;
+  FreespaceSearch rrt_star_;
 };
+
+// [m] With freespace_planner_algorithm rrtstar, FreespacePullOut grows the objects in its costmap
+// by this (the smallest of Autoware's default collision_check_margins): RRT*'s paths, shortest
+// between its samples, run along the obstacles, and the pipeline asks at least this clearance to
+// the objects of a path. Where the start is closer than that to an object (its footprint, with
+// the start-aware margin, collides), the objects are not grown. Hybrid A* searches the plain
+// costmap (its paths kept this clearance on every scenario, its figures are with it).
+constexpr double kRrtStarObjectClearance = 0.1;
+
+// Each polygon grown by `d` [m] on every side, conservatively: the convex hull of its vertices
+// moved by +-d in x and y (for a convex polygon a superset of the points within d of it; a
+// polygon that is not convex becomes its grown hull).
+std::vector<Polygon> grown_obstacles(const std::vector<Polygon>& obstacles, double d);
+
+// The search freespace_planner_algorithm names: hybrid A* for "astar", `rrt_star` for "rrtstar"
+// (std::invalid_argument when it is empty, or for another name).
+FreespaceSearch freespace_search(const FreespaceParameters& parameters, const FreespaceSearch& rrt_star);
 
 // The search settings the freespace parameters imply for this vehicle.
 HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const FreespaceParameters& parameters);
@@ -95,6 +116,6 @@ struct FreespaceGoalResult {
 };
 FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const VehicleInfo& vehicle,
                                            const FreespaceParameters& parameters, const Pose2& start, const Pose2& goal,
-                                           const StopCondition& stop);
+                                           const StopCondition& stop, const FreespaceSearch& rrt_star = {});
 
 }  // namespace pullout
