@@ -15,7 +15,10 @@
 // Ours twice: freespace_planner_algorithm astar (hybrid A*) and rrtstar (freespace_ompl's seeded,
 // retried RRT*, run_rrt_star). --no-peers skips the OMPL RRT*/BIT* peers (plain OMPL, seeded by
 // the process-wide ompl::RNG::setSeed).
-// --ours-only skips OMPL and prints the expansions of each search. With the environment variable
+// --ours-only skips OMPL and prints, per problem, the expansions of the search, the costmap's build
+// time (wall clock; thread CPU time next to the search's: steadier on a loaded machine) and the
+// share of the distance field's row segments the search filled (Costmap builds its tables
+// lazily), then the medians and p95 of build, search and both. With the environment variable
 // PULLOUT_DUMP_EXPANSIONS=<dir>, each problem's costmap (<i>.pgm) and the poses our search expanded
 // (<i>.txt: "E x y yaw" lines) are written there, to see where a search spends its time.
 //
@@ -35,6 +38,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <limits>
 #include <memory>
 #include <random>
@@ -66,6 +70,13 @@
 namespace {
 
 namespace ob = ompl::base;
+
+// CPU time of the calling thread [ms]: steadier than wall-clock time on a loaded machine.
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
 namespace og = ompl::geometric;
 using pullout::Pose2;
 
@@ -83,6 +94,8 @@ struct Problem {
   pullout::Costmap costmap;
   Pose2 start;
   Pose2 goal;
+  double build_ms{0.0};  // the costmap's construction from the obstacles (rasterisation and tables)
+  double build_cpu_ms{0.0};
 };
 
 using pullout::bench::box;
@@ -141,7 +154,11 @@ Problem make_problem(int index, std::mt19937& rng, const pullout::Footprint& fp)
   }
   std::vector<std::uint8_t> occ(static_cast<std::size_t>(cells) * cells, 0);
   p.costmap = pullout::Costmap({0, 0, 0}, p.resolution, cells, cells, std::move(occ));
+  const auto b0 = std::chrono::steady_clock::now();
+  const double c0 = thread_cpu_ms();
   p.costmap.add_obstacles(obstacles);
+  p.build_cpu_ms = thread_cpu_ms() - c0;
+  p.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - b0).count();
   // Parked in a bay: rear bumper 0.3 m inside the opening. Nose-in faces away from the aisle.
   const auto parked = [&](const Bay& b, bool nose_in) {
     const double inward = -b.faces;  // +y or -y into the bay
@@ -190,6 +207,7 @@ struct Run {
   pullout::PathShape raw;
   pullout::PathShape smooth;
   double smooth_ms{0.0};
+  double cpu_ms{0.0};  // the search's thread CPU time
   int segments{0};
   int refused{0};
 };
@@ -210,9 +228,11 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   config.distance_heuristic_weight = heuristic_weight;
   const pullout::HybridAStar planner(checker, config);
   const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = thread_cpu_ms();
   const pullout::HybridAStarResult r = planner.plan(p.start, p.goal, pullout::StopCondition::after_ms(budget_ms));
   Run run;
   run.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  run.cpu_ms = thread_cpu_ms() - cpu0;
   run.success = r.status == pullout::HybridAStarResult::Status::kSuccess;
   run.length = r.length;
   run.expansions = r.expansions;
@@ -393,7 +413,11 @@ bool make_tpcap(const std::string& dir, int number, double resolution, Problem& 
   out.name = "tpcap " + std::to_string(number);
   out.size = std::max(hi.x() - lo.x(), hi.y() - lo.y());
   out.resolution = resolution;
+  const auto b0 = std::chrono::steady_clock::now();
+  const double c0 = thread_cpu_ms();
   out.costmap = pullout::Costmap::from_polygons(extent, resolution, {all}, {}, c.obstacles);
+  out.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - b0).count();
+  out.build_cpu_ms = thread_cpu_ms() - c0;
   out.start = {c.start.x - lo.x(), c.start.y - lo.y(), c.start.yaw};
   out.goal = {c.goal.x - lo.x(), c.goal.y - lo.y(), c.goal.yaw};
   return true;
@@ -476,6 +500,8 @@ int main(int argc, char** argv) {
   const char* names[kPlanners] = {"astar (pullout)", "rrtstar (pullout)", "OMPL RRT*", "OMPL BIT*"};
   std::vector<Run> runs[kPlanners];
   std::vector<double> small_ours;  // 30 m at 0.2 m
+  std::vector<double> cpu_builds, cpu_searches, cpu_totals;  // the same in thread CPU time
+  std::vector<double> builds, totals;  // --ours-only: costmap build [ms], build + search (failures +inf)
   std::printf("%-18s %28s %28s %28s %28s\n", "problem", names[0], names[1], names[2], names[3]);
   for (int i = 0; i < problems; ++i) {
     Problem p;
@@ -498,9 +524,22 @@ int main(int argc, char** argv) {
     if (ours_only) {
       const Run r = run_ours(p, checker, radius, budget_ms, heuristic_weight);
       runs[0].push_back(r);
-      std::printf("%-18s %8.1f ms %6.1f m %2d cusps %8zu expansions%s%s\n", p.name.c_str(), r.time_ms, r.length,
-                  r.direction_changes, r.expansions, r.success ? "" : "  (no solution)",
-                  r.from_goal ? "  (from the goal)" : "");
+      builds.push_back(p.build_ms);
+      cpu_builds.push_back(p.build_cpu_ms);
+      cpu_searches.push_back(r.cpu_ms);
+      cpu_totals.push_back(r.success ? p.build_cpu_ms + r.cpu_ms : std::numeric_limits<double>::infinity());
+      totals.push_back(r.success ? p.build_ms + r.time_ms : std::numeric_limits<double>::infinity());
+      const pullout::DistanceField& field = p.costmap.distance_field();
+      const double filled = field.empty() ? 0.0
+                                          : 100.0 * static_cast<double>(field.filled_segments()) /
+                                                (static_cast<double>(field.height()) *
+                                                 ((field.width() + pullout::DistanceField::kSegmentCells - 1) /
+                                                  pullout::DistanceField::kSegmentCells));
+      std::printf(
+          "%-18s %8.1f ms %6.1f m %2d cusps %8zu expansions  build %5.1f ms  cpu %5.1f + %5.1f ms %5.1f %% "
+          "filled%s%s\n",
+          p.name.c_str(), r.time_ms, r.length, r.direction_changes, r.expansions, p.build_ms, p.build_cpu_ms, r.cpu_ms,
+          filled, r.success ? "" : "  (no solution)", r.from_goal ? "  (from the goal)" : "");
       if (!r.success) std::printf("%-18s   status %d (HybridAStarResult::Status)\n", "", r.status);
       if (p.size == 30.0 && p.resolution > 0.15 && r.success) small_ours.push_back(r.time_ms);
       continue;
@@ -553,6 +592,16 @@ int main(int argc, char** argv) {
     std::printf("| %s | %zu/%zu | %s | %s | %s | %.1f | %.2f |\n", names[k], solved.size(), runs[k].size(),
                 fmt(percentile(all, 0.5)).c_str(), fmt(percentile(all, 0.95)).c_str(),
                 fmt(percentile(solved, 0.5)).c_str(), len / n, changes / n);
+  }
+  if (ours_only) {
+    std::printf("\ncostmap build: median %.2f ms, p95 %.2f ms, max %.2f ms; build + search: median %s ms, p95 %s ms\n",
+                percentile(builds, 0.5), percentile(builds, 0.95), percentile(builds, 1.0),
+                fmt(percentile(totals, 0.5)).c_str(), fmt(percentile(totals, 0.95)).c_str());
+    std::printf(
+        "CPU time: build median %.2f ms, p95 %.2f; search median %.2f, p95 %.2f; build + search median %s, p95 %s\n",
+        percentile(cpu_builds, 0.5), percentile(cpu_builds, 0.95), percentile(cpu_searches, 0.5),
+        percentile(cpu_searches, 0.95), fmt(percentile(cpu_totals, 0.5)).c_str(),
+        fmt(percentile(cpu_totals, 0.95)).c_str());
   }
   std::printf("\nload average at the end: %s\n", pullout::bench::load_text().c_str());
   std::printf("\nhybrid A* median on 30 m x 30 m at 0.2 m: %.1f ms (%zu problems)\n", percentile(small_ours, 0.5),

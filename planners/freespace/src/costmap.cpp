@@ -11,38 +11,6 @@ namespace {
 
 constexpr double kSqrt2 = 1.41421356237309504880;
 
-// One dimension of the squared Euclidean distance transform of a sampled function (Felzenszwalb &
-// Huttenlocher 2012): d[q] = min_p (q - p)^2 + f[p]. Free samples carry a large finite value
-// (kFar) instead of infinity, which keeps the parabola intersections well defined. v, z are
-// scratch of sizes n and n + 1.
-constexpr double kFar = 1e30;
-
-void distance_transform_1d(const double* f, int n, double* d, int* v, double* z) {
-  int k = 0;
-  v[0] = 0;
-  z[0] = -std::numeric_limits<double>::infinity();
-  z[1] = std::numeric_limits<double>::infinity();
-  for (int q = 1; q < n; ++q) {
-    double s = 0.0;
-    while (true) {
-      const int p = v[k];
-      s = ((f[q] + static_cast<double>(q) * q) - (f[p] + static_cast<double>(p) * p)) / (2.0 * (q - p));
-      if (s > z[k]) break;  // z[0] = -inf ends the loop at k = 0
-      --k;
-    }
-    ++k;
-    v[k] = q;
-    z[k] = s;
-    z[k + 1] = std::numeric_limits<double>::infinity();
-  }
-  k = 0;
-  for (int q = 0; q < n; ++q) {
-    while (z[k + 1] < static_cast<double>(q)) ++k;
-    const double dq = static_cast<double>(q - v[k]);
-    d[q] = dq * dq + f[v[k]];
-  }
-}
-
 // v (an integral value: a floor or ceil) as an int clamped to [lo, hi]. The comparison comes
 // before the conversion, so v may be of any size; NaN gives lo.
 int clamped_int(double v, int lo, int hi) {
@@ -307,7 +275,7 @@ double Costmap::clearance_lower_bound(const Vec2& p_M) const {
   cell_of(p_M, ix, iy);
   if (occupied(ix, iy)) return 0.0;
   // p is within res/sqrt2 of its cell centre, and an occupied square within res/sqrt2 of its own.
-  return std::max(0.0, static_cast<double>(distance_[index(ix, iy)]) - kSqrt2 * resolution_);
+  return std::max(0.0, centre_distance(ix, iy) - kSqrt2 * resolution_);
 }
 
 int Costmap::occupied_in_row(int iy, int c0, int c1) const { return static_cast<int>(occupied_in_box(c0, iy, c1, iy)); }
@@ -325,66 +293,22 @@ long long Costmap::occupied_in_box(int c0, int r0, int c1, int r1) const {
 }
 
 void Costmap::precompute(const StopCondition& stop) {
-  const std::size_t stride = static_cast<std::size_t>(width_) + 1;
+  box_ = BoxCounts();
+  hard_box_ = BoxCounts();
+  distance_ = DistanceField();
   if (!partial_.empty()) {
     std::sort(partial_.begin(), partial_.end());
     partial_.erase(std::unique(partial_.begin(), partial_.end()), partial_.end());
     // A cell made hard by a later shape needs no exact test.
     partial_.erase(std::remove_if(partial_.begin(), partial_.end(), [&](const auto& e) { return hard_[e.first] != 0; }),
                    partial_.end());
-    hard_prefix_.assign(stride * (static_cast<std::size_t>(height_) + 1), 0);
-    for (int j = 0; j < height_; ++j) {
-      const std::int32_t* below = hard_prefix_.data() + static_cast<std::size_t>(j) * stride;
-      std::int32_t* box = hard_prefix_.data() + static_cast<std::size_t>(j + 1) * stride;
-      std::int32_t row = 0;
-      for (int i = 0; i < width_; ++i) {
-        row += hard_[index(i, j)] != 0 ? 1 : 0;
-        box[i + 1] = below[i + 1] + row;
-      }
-    }
-  } else {
-    hard_prefix_.clear();
   }
-  box_prefix_.assign(stride * (static_cast<std::size_t>(height_) + 1), 0);
-  for (int j = 0; j < height_; ++j) {
-    if (stop_now(stop, j, stopped_)) return;
-    const std::int32_t* below = box_prefix_.data() + static_cast<std::size_t>(j) * stride;
-    std::int32_t* box = box_prefix_.data() + static_cast<std::size_t>(j + 1) * stride;
-    std::int32_t row = 0;  // occupied cells of row j left of column i + 1
-    for (int i = 0; i < width_; ++i) {
-      row += occupied_[index(i, j)] != 0 ? 1 : 0;
-      box[i + 1] = below[i + 1] + row;
-    }
-  }
-
-  // Squared distance transform on the grid padded by one occupied cell on every side.
-  const int pw = width_ + 2;
-  const int ph = height_ + 2;
-  std::vector<double> f(static_cast<std::size_t>(pw) * ph, 0.0);
-  for (int j = 0; j < height_; ++j) {
-    for (int i = 0; i < width_; ++i) {
-      f[static_cast<std::size_t>(j + 1) * pw + (i + 1)] = occupied_[index(i, j)] != 0 ? 0.0 : kFar;
-    }
-  }
-  const int n = std::max(pw, ph);
-  std::vector<double> in(n);
-  std::vector<double> out(n);
-  std::vector<double> z(n + 1);
-  std::vector<int> v(n);
-  for (int i = 0; i < pw; ++i) {  // columns
-    if (stop_now(stop, i, stopped_)) return;
-    for (int j = 0; j < ph; ++j) in[j] = f[static_cast<std::size_t>(j) * pw + i];
-    distance_transform_1d(in.data(), ph, out.data(), v.data(), z.data());
-    for (int j = 0; j < ph; ++j) f[static_cast<std::size_t>(j) * pw + i] = out[j];
-  }
-  distance_.assign(static_cast<std::size_t>(width_) * height_, 0.0F);
-  for (int j = 1; j <= height_; ++j) {  // rows (the padding rows are not needed any more)
-    if (stop_now(stop, j, stopped_)) return;
-    distance_transform_1d(&f[static_cast<std::size_t>(j) * pw], pw, out.data(), v.data(), z.data());
-    for (int i = 1; i <= width_; ++i) {
-      distance_[index(i - 1, j - 1)] = static_cast<float>(std::sqrt(out[i]) * resolution_);
-    }
-  }
+  if (empty()) return;
+  StopReason reason = StopReason::kNone;
+  if (!partial_.empty()) reason = hard_box_.build(hard_.data(), width_, height_, stop);
+  if (reason == StopReason::kNone) reason = box_.build(occupied_.data(), width_, height_, stop);
+  if (reason == StopReason::kNone) reason = distance_.build(occupied_.data(), width_, height_, resolution_, stop);
+  if (reason != StopReason::kNone) stopped_ = reason;
 }
 
 }  // namespace pullout

@@ -62,7 +62,7 @@ class Search {
         backward_(backward),
         rs_(config.turning_radius),
         weights_{config.curve_weight, config.reverse_weight, config.direction_change_weight},
-        heuristic_(costmap_, heuristic_config(checker, config), target) {}
+        heuristic_(costmap_, heuristic_config(checker, config), target, root) {}
 
   // Puts the root (known free, with clearance bound `clearance`) on the open list.
   void begin(const StopCondition& stop, double clearance) {

@@ -118,7 +118,8 @@ bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, do
   return true;
 }
 
-ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal)
+ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal,
+                                     const Pose2& toward)
     : costmap_(costmap), config_(config) {
   factor_ = std::max(1, static_cast<int>(std::round(config.cell_size / costmap.resolution())));
   cell_size_ = factor_ * costmap.resolution();
@@ -127,13 +128,26 @@ ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuri
   const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
   distance_.assign(n, std::numeric_limits<float>::infinity());
   rate_.assign(n, std::numeric_limits<float>::quiet_NaN());
+  int ti = 0;
+  int tj = 0;
+  costmap.cell_of({toward.x, toward.y}, ti, tj);
+  toward_x_ = std::clamp(ti, 0, costmap.width() - 1) / factor_;
+  toward_y_ = std::clamp(tj, 0, costmap.height() - 1) / factor_;
   int gi = 0;
   int gj = 0;
   costmap.cell_of({goal.x, goal.y}, gi, gj);
   if (!costmap.inside(gi, gj)) return;
   const std::int32_t start = (gj / factor_) * width_ + (gi / factor_);
   distance_[static_cast<std::size_t>(start)] = 0.0F;
-  open_.push({0.0F, start});
+  open_.push({estimate(start), start});
+}
+
+float ObstacleHeuristic::estimate(std::int32_t c) const {
+  // The straight line between the cell centres, less 1 % so that float rounding cannot make it
+  // overestimate a path of edges (each at least its length: every rate is at least 1).
+  const auto dx = static_cast<float>(c % width_ - toward_x_);
+  const auto dy = static_cast<float>(c / width_ - toward_y_);
+  return 0.99F * static_cast<float>(cell_size_) * std::sqrt(dx * dx + dy * dy);
 }
 
 float ObstacleHeuristic::rate(std::int32_t c) {
@@ -163,20 +177,23 @@ float ObstacleHeuristic::rate(std::int32_t c) {
 }
 
 float ObstacleHeuristic::settle(std::int32_t c) {
-  // A cell's distance is final once nothing left on the open list is closer to the goal.
+  // A cell's distance is final once nothing left on the open list can lower it: every open entry's
+  // distance plus its (consistent) estimate is at least the cell's distance plus its own.
   const float straight = static_cast<float>(cell_size_);
   const float diagonal = static_cast<float>(cell_size_ * std::sqrt(2.0));
   constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
   constexpr std::size_t kStopCheckInterval = 1024;
-  while (!open_.empty() && open_.top().first < distance_[static_cast<std::size_t>(c)]) {
+  const float own_estimate = estimate(c);
+  while (!open_.empty() && open_.top().first < distance_[static_cast<std::size_t>(c)] + own_estimate) {
     if (stopped_ != StopReason::kNone) break;
     if (stop_ != nullptr && ++settled_ % kStopCheckInterval == 0 && (stopped_ = stop_->check()) != StopReason::kNone) {
       break;
     }
-    const auto [d, idx] = open_.top();
+    const auto [f, idx] = open_.top();
     open_.pop();
-    if (d > distance_[static_cast<std::size_t>(idx)]) continue;
+    const float d = distance_[static_cast<std::size_t>(idx)];
+    if (f > d + estimate(idx)) continue;  // superseded by a shorter distance
     const float own = rate(idx);
     const int x = idx % width_;
     const int y = idx / width_;
@@ -193,7 +210,7 @@ float ObstacleHeuristic::settle(std::int32_t c) {
       const float nd = d + (k < 4 ? straight : diagonal) * mean;
       if (nd < distance_[static_cast<std::size_t>(nidx)]) {
         distance_[static_cast<std::size_t>(nidx)] = nd;
-        open_.push({nd, nidx});
+        open_.push({nd + estimate(nidx), nidx});
       }
     }
   }

@@ -80,10 +80,17 @@ struct ObstacleHeuristicConfig {
   double narrow_penalty{0.0};
 };
 
-// Computed lazily: the Dijkstra search from the goal runs only until the cells asked for are
-// final, and a cell's passability and rate are worked out when the search first reaches it, so
-// the cost follows the part of the map the hybrid A* explores, not the map's size. Not thread
-// safe (distance() advances the search); one per plan.
+// Computed lazily: the search from the goal runs only until the cells asked for are final, and a
+// cell's passability and rate are worked out when the search first reaches it, so the cost
+// follows the part of the map the hybrid A* explores, not the map's size. The search from the
+// goal is an A* towards the cell the hybrid A* starts from ("reverse resumable A*": D. Silver,
+// "Cooperative Pathfinding", AIIDE 2005), its estimate the straight-line distance (every rate is
+// at least 1, so it never overestimates and is consistent): where a Dijkstra search would settle
+// every cell closer to the goal than the start (most of a lot whose goal and start lie at opposite
+// ends, and the distance transform under it), it settles a corridor between them. A cell's
+// distance is final once nothing left on the open list could still lower it, whatever the order:
+// the distances are the same as a Dijkstra search's. Not thread safe (distance() advances the
+// search); one per plan.
 //
 // One distance() may have to flood the whole grid (a pose the goal cannot be reached from): with
 // watch(stop), that flood checks the stop condition every 1024 cells it settles, and once it says
@@ -91,7 +98,9 @@ struct ObstacleHeuristicConfig {
 // ends its search on stopped()).
 class ObstacleHeuristic {
  public:
-  ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal);
+  // Distances to `goal`; `toward` is where the queries begin (the hybrid A*'s root).
+  ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuristicConfig& config, const Pose2& goal,
+                    const Pose2& toward);
 
   // The stop condition to honour inside distance(); must outlive this object.
   void watch(const StopCondition& stop) { stop_ = &stop; }
@@ -103,6 +112,8 @@ class ObstacleHeuristic {
  private:
   // The final distance of coarse cell `c`, running the search as far as that needs.
   float settle(std::int32_t c);
+  // The A* estimate of coarse cell `c`: a lower bound of its distance to `toward`'s cell [m].
+  float estimate(std::int32_t c) const;
   // Per-metre cost of crossing coarse cell `c` (+inf: blocked), from its costmap cells on first use.
   float rate(std::int32_t c);
 
@@ -114,7 +125,9 @@ class ObstacleHeuristic {
   double cell_size_{0.0};
   std::vector<float> distance_;
   std::vector<float> rate_;  // NaN until computed
-  using Item = std::pair<float, std::int32_t>;
+  int toward_x_{0};          // the coarse cell of `toward`
+  int toward_y_{0};
+  using Item = std::pair<float, std::int32_t>;  // (distance + estimate, cell)
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open_;
   const StopCondition* stop_{nullptr};
   StopReason stopped_{StopReason::kNone};

@@ -21,19 +21,24 @@
 // collision checker tests partial cells against the listed shapes exactly (partial_shapes,
 // hard_in_box_inside, inside_drivable). A grid from a request has no shapes: all its cells are hard.
 //
-// The distance transform is exact for cell centres (Felzenszwalb & Huttenlocher, "Distance
-// Transforms of Sampled Functions", Theory of Computing 8, 2012).
+// The distance transform is exact for cell centres. It and the summed-area tables are computed
+// lazily (DistanceField, BoxCounts): building leaves one read-only sweep of the grid per table;
+// the rest is filled per band of rows or row segment where the search first asks, so a search
+// that stays in one part of a large map pays for that part.
 //
 // Building costs O(cells) (up to 16384 x 16384 from polygons, max_grid_cells from a grid) and
 // honours a stop condition: it is checked before every drivable polygon, every 64 rows of the
-// rasterisation, every 64 obstacle polygons, and every 64 rows or columns of the summed-area table
-// and the distance transform. A build it cuts short returns at once with stopped() set; such a
-// costmap is incomplete and must not be searched.
+// rasterisation, every 64 obstacle polygons, and every 64 rows of the tables' sweeps. A build it
+// cuts short returns at once with stopped() set; such a costmap is incomplete and must not be
+// searched. The fills on first use take no stop condition: each is bounded (a band of 64 rows, a
+// row segment).
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "pullout/freespace/box_counts.hpp"
+#include "pullout/freespace/distance_field.hpp"
 #include "pullout/geometry/polygon.hpp"
 #include "pullout/model/types.hpp"
 #include "pullout/search/stop_condition.hpp"
@@ -73,11 +78,8 @@ class Costmap {
   bool has_partial() const { return !partial_.empty(); }
   // Hard (entirely covered) cells in the box, as occupied_in_box_inside.
   int hard_in_box_inside(int c0, int r0, int c1, int r1) const {
-    if (hard_prefix_.empty()) return occupied_in_box_inside(c0, r0, c1, r1);
-    const std::size_t stride = static_cast<std::size_t>(width_) + 1;
-    const std::int32_t* lo = hard_prefix_.data() + static_cast<std::size_t>(r0) * stride;
-    const std::int32_t* hi = hard_prefix_.data() + static_cast<std::size_t>(r1 + 1) * stride;
-    return hi[c1 + 1] - hi[c0] - lo[c1 + 1] + lo[c0];
+    if (hard_box_.empty()) return occupied_in_box_inside(c0, r0, c1, r1);
+    return hard_box_.count(c0, r0, c1, r1, hard_.data());
   }
   // Appends the indices (into shapes()) of the shapes meeting partial cell (ix, iy) in the grid.
   void partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) const;
@@ -108,8 +110,10 @@ class Costmap {
   bool inside(int ix, int iy) const { return ix >= 0 && iy >= 0 && ix < width_ && iy < height_; }
 
   // Distance [m] from the centre of cell (ix, iy) to the centre of the nearest occupied cell
-  // (inside the grid; the grid border counts as occupied, one cell beyond the edge).
-  double centre_distance(int ix, int iy) const { return distance_[index(ix, iy)]; }
+  // (inside the grid; the grid border counts as occupied, one cell beyond the edge). The first
+  // call in a row segment computes that segment (see DistanceField).
+  double centre_distance(int ix, int iy) const { return distance_.at(ix, iy, occupied_.data()); }
+  const DistanceField& distance_field() const { return distance_; }
   // A lower bound [m] of the distance from map point p to the nearest occupied cell (as a closed
   // square); 0 outside the grid or on an occupied cell.
   double clearance_lower_bound(const Vec2& p_M) const;
@@ -124,10 +128,7 @@ class Costmap {
   // The same for a non-empty box inside the grid (0 <= c0 <= c1 < width, 0 <= r0 <= r1 < height),
   // without the clamping: the collision checker's hot path.
   int occupied_in_box_inside(int c0, int r0, int c1, int r1) const {
-    const std::size_t stride = static_cast<std::size_t>(width_) + 1;
-    const std::int32_t* lo = box_prefix_.data() + static_cast<std::size_t>(r0) * stride;
-    const std::int32_t* hi = box_prefix_.data() + static_cast<std::size_t>(r1 + 1) * stride;
-    return hi[c1 + 1] - hi[c0] - lo[c1 + 1] + lo[c0];
+    return box_.count(c0, r0, c1, r1, occupied_.data());
   }
 
  private:
@@ -150,16 +151,14 @@ class Costmap {
   int width_{0};
   int height_{0};
   std::vector<std::uint8_t> occupied_;
-  std::vector<float> distance_;  // [m] see centre_distance
-  // Summed-area table, (width + 1) x (height + 1): occupied cells in columns < c and rows < r (a
-  // row's count is the difference of two neighbouring table rows).
-  std::vector<std::int32_t> box_prefix_;
+  DistanceField distance_;  // [m] see centre_distance
+  BoxCounts box_;           // occupied cells in boxes (a summed-area table, filled where asked)
   StopReason stopped_{StopReason::kNone};
   // The exact layer (see the file comment): hard_ per cell (empty: every occupied cell is hard),
-  // its summed-area table, the (cell index, shape index) pairs of partial cells sorted, the shapes,
+  // its box counts, the (cell index, shape index) pairs of partial cells sorted, the shapes,
   // and the drivable polygons (grid frame).
   std::vector<std::uint8_t> hard_;
-  std::vector<std::int32_t> hard_prefix_;
+  BoxCounts hard_box_;  // empty: no exact layer
   std::vector<std::pair<std::uint32_t, std::uint32_t>> partial_;
   std::vector<Shape> shapes_;
   std::vector<std::vector<Vec2>> drivable_;

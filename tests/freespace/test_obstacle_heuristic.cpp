@@ -1,0 +1,144 @@
+// The obstacle-aware distance of the hybrid A* (search_support.hpp), computed lazily by an A*
+// towards the search's root. Oracle: a plain Dijkstra search over every coarse cell, written here,
+// on rates computed from brute-force distances: the order in which the lazy search settles cells
+// must not change a distance.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <random>
+#include <vector>
+
+#include "search_support.hpp"
+
+namespace pullout {
+namespace {
+
+namespace fd = freespace_detail;
+
+constexpr double kRes = 0.1;
+constexpr int kFactor = 5;  // costmap cells per coarse cell (0.5 m)
+
+struct Map {
+  int w{0};
+  int h{0};
+  std::vector<std::uint8_t> occ;
+};
+
+// Rooms and walls with random boxes: narrow places (rates above 1) and blocked cells.
+Map random_map(std::mt19937& rng) {
+  Map m{150, 100, std::vector<std::uint8_t>(150 * 100, 0)};
+  std::uniform_int_distribution<int> x(0, m.w - 1), y(0, m.h - 1), side(2, 16);
+  for (int k = 0; k < 12; ++k) {
+    const int x0 = x(rng), y0 = y(rng), sx = side(rng), sy = side(rng);
+    for (int j = y0; j < std::min(m.h, y0 + sy); ++j) {
+      for (int i = x0; i < std::min(m.w, x0 + sx); ++i) m.occ[static_cast<std::size_t>(j) * m.w + i] = 1;
+    }
+  }
+  return m;
+}
+
+double brute_distance(const Map& m, const std::vector<std::pair<int, int>>& occupied, int i, int j) {
+  double best = std::min({i + 1, j + 1, m.w - i, m.h - j});
+  for (const auto& [x, y] : occupied) best = std::min(best, std::hypot(x - i, y - j));
+  return best * kRes;
+}
+
+TEST(ObstacleHeuristic, LazySearchTowardsTheRootGivesDijkstraDistances) {
+  std::mt19937 rng(13);
+  for (int trial = 0; trial < 2; ++trial) {
+    const Map m = random_map(rng);
+    const Costmap costmap({}, kRes, m.w, m.h, m.occ);
+    std::vector<std::pair<int, int>> occupied;
+    for (int y = 0; y < m.h; ++y) {
+      for (int x = 0; x < m.w; ++x) {
+        if (m.occ[static_cast<std::size_t>(y) * m.w + x] != 0) occupied.emplace_back(x, y);
+      }
+    }
+    fd::ObstacleHeuristicConfig config;
+    config.half_width = 0.6;
+    config.cell_size = kRes * kFactor;
+    config.turning_room = 1.5;
+    config.narrow_penalty = 3.0;
+    // The documented rates, from brute-force distances.
+    const int cw = m.w / kFactor, ch = m.h / kFactor;
+    std::vector<float> rate(static_cast<std::size_t>(cw) * ch);
+    for (int cj = 0; cj < ch; ++cj) {
+      for (int ci = 0; ci < cw; ++ci) {
+        bool blocked = true;
+        double room = 0.0;
+        for (int j = cj * kFactor; j < (cj + 1) * kFactor; ++j) {
+          for (int i = ci * kFactor; i < (ci + 1) * kFactor; ++i) {
+            if (m.occ[static_cast<std::size_t>(j) * m.w + i] != 0) continue;
+            const double d = brute_distance(m, occupied, i, j);
+            room = std::max(room, d);
+            if (d + std::sqrt(2.0) * kRes >= config.half_width) blocked = false;
+          }
+        }
+        rate[static_cast<std::size_t>(cj) * cw + ci] =
+            blocked ? std::numeric_limits<float>::infinity()
+                    : static_cast<float>(1.0 + config.narrow_penalty * std::max(0.0, 1.0 - room / config.turning_room));
+      }
+    }
+    // Dijkstra from the goal's coarse cell over every cell (edges: length x mean rate of the two).
+    std::uniform_int_distribution<int> cx(0, cw - 1), cy(0, ch - 1);
+    int gx = cx(rng), gy = cy(rng);
+    while (std::isinf(rate[static_cast<std::size_t>(gy) * cw + gx])) {
+      gx = cx(rng);
+      gy = cy(rng);
+    }
+    std::vector<float> dist(rate.size(), std::numeric_limits<float>::infinity());
+    using Item = std::pair<float, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
+    dist[static_cast<std::size_t>(gy) * cw + gx] = 0.0F;
+    open.push({0.0F, gy * cw + gx});
+    while (!open.empty()) {
+      const auto [d, c] = open.top();
+      open.pop();
+      if (d > dist[static_cast<std::size_t>(c)]) continue;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int nx = c % cw + dx, ny = c / cw + dy;
+          if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= cw || ny >= ch) continue;
+          const float next = rate[static_cast<std::size_t>(ny) * cw + nx];
+          if (std::isinf(next)) continue;
+          const float own = rate[static_cast<std::size_t>(c)];
+          const float mean = std::isinf(own) ? next : 0.5F * (own + next);
+          const float len = static_cast<float>(kRes * kFactor * (dx != 0 && dy != 0 ? std::sqrt(2.0) : 1.0));
+          const float nd = d + len * mean;
+          if (nd < dist[static_cast<std::size_t>(ny) * cw + nx]) {
+            dist[static_cast<std::size_t>(ny) * cw + nx] = nd;
+            open.push({nd, ny * cw + nx});
+          }
+        }
+      }
+    }
+    // The lazy search, asked at coarse cell centres (there its bilinear value is the cell's own)
+    // in a random order, from a root somewhere else.
+    const auto centre = [&](int ci, int cj) {
+      return Pose2{(ci + 0.5) * kFactor * kRes, (cj + 0.5) * kFactor * kRes, 0.0};
+    };
+    fd::ObstacleHeuristic heuristic(costmap, config, centre(gx, gy), centre(cx(rng), cy(rng)));
+    std::vector<int> order(rate.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+    std::shuffle(order.begin(), order.end(), rng);
+    int finite = 0;
+    for (const int c : order) {
+      const double expected = dist[static_cast<std::size_t>(c)];
+      const double got = heuristic.distance(centre(c % cw, c / cw));
+      if (std::isinf(expected) || std::isinf(rate[static_cast<std::size_t>(c)])) {
+        EXPECT_TRUE(std::isinf(got)) << "cell " << c % cw << "," << c / cw;
+        continue;
+      }
+      ++finite;
+      // Float sums over paths of equal length may round differently: a relative 1e-5.
+      ASSERT_NEAR(got, expected, 1e-5 * std::max(1.0, expected)) << "cell " << c % cw << "," << c / cw;
+    }
+    EXPECT_GT(finite, cw * ch / 3);  // the map is mostly connected: the test compares many cells
+  }
+}
+
+}  // namespace
+}  // namespace pullout
