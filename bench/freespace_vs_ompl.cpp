@@ -499,7 +499,7 @@ int main(int argc, char** argv) {
   constexpr int kPlanners = 4;
   const char* names[kPlanners] = {"astar (pullout)", "rrtstar (pullout)", "OMPL RRT*", "OMPL BIT*"};
   std::vector<Run> runs[kPlanners];
-  std::vector<double> small_ours;  // 30 m at 0.2 m
+  std::vector<double> small_ours;                            // 30 m at 0.2 m
   std::vector<double> cpu_builds, cpu_searches, cpu_totals;  // the same in thread CPU time
   std::vector<double> builds, totals;  // --ours-only: costmap build [ms], build + search (failures +inf)
   std::printf("%-18s %28s %28s %28s %28s\n", "problem", names[0], names[1], names[2], names[3]);

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "observability/http_endpoint.hpp"
 #include "observability/service_metrics.hpp"
 #include "service/vehicle_registry.hpp"
 
@@ -91,6 +92,23 @@ TEST(ServiceMetrics, EvictionsByReason) {
   EXPECT_TRUE(has_line(text, "pullout_evictions_total{reason=\"idle\"} 2")) << text;
   EXPECT_TRUE(has_line(text, "pullout_evictions_total{reason=\"capacity\"} 1")) << text;
   EXPECT_TRUE(has_line(text, "pullout_evictions_total{reason=\"gone\"} 0")) << text;
+}
+
+// /readyz of a replica: not ready while it syncs with the other replicas (it answers nothing then).
+TEST(HealthState, AReplicaIsReadyOnlyOnceInStep) {
+  HealthState h;
+  h.config_loaded = true;
+  h.dds_ready = true;
+  h.workers_running = true;
+  h.beat();
+  bool ready = false;
+  EXPECT_NE(h.readiness(ready).find("in step"), std::string::npos);
+  EXPECT_TRUE(ready);
+  h.in_step = false;
+  const std::string body = h.readiness(ready);
+  EXPECT_FALSE(ready) << body;
+  EXPECT_EQ(body.rfind("not ready\n", 0), 0u) << body;
+  EXPECT_NE(body.find("not yet in step with the other replicas"), std::string::npos) << body;
 }
 
 }  // namespace

@@ -71,6 +71,8 @@ std::string HealthState::readiness(bool& ready) const {
   fact(dds_ready.load(), "dds participant and endpoints created", "dds participant and endpoints not created");
   fact(workers_running.load(), "planning threads running", "planning threads not running");
   fact(alive(), "dispatcher loop responsive", "dispatcher loop not responding");
+  fact(in_step.load(), "in step with the other replicas (or not a replica)",
+       "not yet in step with the other replicas (start-up sync)");
   body += "other pullout services on the domain: " + std::to_string(other_services.load()) + '\n';
   body.insert(0, ready ? "ready\n" : "not ready\n");
   return body;

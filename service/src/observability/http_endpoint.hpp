@@ -32,6 +32,9 @@ struct HealthState {
   std::atomic<bool> config_loaded{false};
   std::atomic<bool> dds_ready{false};
   std::atomic<bool> workers_running{false};
+  // Replica mode: false until the start-up sync with the other replicas is over (until then the
+  // service answers no request).
+  std::atomic<bool> in_step{true};
   std::atomic<Clock::rep> heartbeat{0};  // steady_clock ticks of the dispatcher's last turn (0: never)
   std::atomic<std::uint32_t> other_services{0};
 

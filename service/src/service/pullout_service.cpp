@@ -91,7 +91,10 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
                         " of the DDS profiles in " + describe_profiles(config.dds) +
                         ": lower max_vehicles or raise max_instances");
   }
-  if (config.service.replica.enabled) shadows_ = std::make_unique<ReplicaShadows>(config.service.max_vehicles);
+  if (config.service.replica.enabled) {
+    shadows_ = std::make_unique<ReplicaShadows>(config.service.max_vehicles);
+    health_.in_step = false;  // until sync_with_replicas
+  }
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
   health_.workers_running = true;
   if (metrics_) {
@@ -382,6 +385,7 @@ void PulloutService::sync_with_replicas() {
     health_.beat();
   }
   const std::size_t vehicles = shadows_->size();
+  health_.in_step = true;
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   if (matched) {
     spdlog::info("replica: in step with {} other replica(s) after {:.0f} ms ({} vehicle(s) served by them)", others, ms,
