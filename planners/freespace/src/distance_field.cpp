@@ -165,7 +165,7 @@ void DistanceField::row_segment(int iy, int x0, int x1, float* out) const {
   // v holds the parabolas on it, z the boundaries between them. The numbers are integers below
   // 2^31 and the boundaries rationals with denominators below 2^16: two different ones differ by
   // far more than double's rounding, so no comparison is decided wrongly.
-  const auto n = static_cast<std::size_t>(hi - lo + 1);
+  const auto n = static_cast<std::size_t>(std::int64_t{hi} - lo + 1);
   // Scratch on the stack unless the window is unusually wide (a segment far from any obstacle):
   // per parabola on the envelope its column (v), f + column^2 (h), and where it begins (z).
   constexpr std::size_t kStackWindow = 1024;

@@ -145,8 +145,10 @@ ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuri
 float ObstacleHeuristic::estimate(std::int32_t c) const {
   // The straight line between the cell centres, less 1 % so that float rounding cannot make it
   // overestimate a path of edges (each at least its length: every rate is at least 1).
-  const auto dx = static_cast<float>(c % width_ - toward_x_);
-  const auto dy = static_cast<float>(c / width_ - toward_y_);
+  const std::int32_t row = c / width_;  // integer division: the cell's row
+  const std::int32_t col = c % width_;
+  const auto dx = static_cast<float>(col - toward_x_);
+  const auto dy = static_cast<float>(row - toward_y_);
   return 0.99F * static_cast<float>(cell_size_) * std::sqrt(dx * dx + dy * dy);
 }
 

@@ -23,7 +23,7 @@ struct UninitialisedAllocator : std::allocator<T> {
   template <class U>
   explicit UninitialisedAllocator(const UninitialisedAllocator<U>& /*unused*/) {}
   template <class U>
-  struct rebind {
+  struct rebind {  // NOLINT(readability-identifier-naming): the allocator requirements' name
     using other = UninitialisedAllocator<U>;
   };
   template <class U, class... Args>
