@@ -60,6 +60,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -302,7 +303,8 @@ int run_worker(const WorkerArgs& a) {
       }
       out << latency << ' ' << (answer.found && answer.waiting_approval ? 1 : 0) << ' '
           << (answer.final_at ? static_cast<double>(answer.published_ns - answer.sent_ns) / 1e6 : -1.0) << ' '
-          << (answer.final_at ? static_cast<double>(answer.arrived_ns - answer.published_ns) / 1e6 : -1.0) << '\n';
+          << (answer.final_at ? static_cast<double>(answer.arrived_ns - answer.published_ns) / 1e6 : -1.0) << ' '
+          << static_cast<double>(answer.sent_ns - start_ns) / 1e9 << '\n';
     }
   }
   out << "mismatched " << mismatched << "\nmax_lag_ms " << max_lag_ms << '\n';
@@ -310,6 +312,13 @@ int run_worker(const WorkerArgs& a) {
   std::filesystem::rename(a.dir + "/result." + std::to_string(a.first) + ".tmp",
                           a.dir + "/result." + std::to_string(a.first));
   note("results written");
+  // Clients leave only once every worker has its results: a worker that finished first and
+  // deleted its clients would load the service (evictions, unregistered instances) while the
+  // others still measure their last requests.
+  const auto leave_deadline = SteadyClock::now() + kDrain + 30s;
+  while (!g_stop.load() && SteadyClock::now() < leave_deadline && !std::filesystem::exists(a.dir + "/leave")) {
+    std::this_thread::sleep_for(10ms);
+  }
   clients.clear();
   note("clients deleted");
   return 0;
@@ -570,7 +579,7 @@ int run_coordinator(const Options& o) {
   const std::uint64_t drops0 = udp_rcvbuf_errors();
   const std::int64_t end_ns = start_ns + static_cast<std::int64_t>(o.duration * 1e9);
   // Per service: vehicle sessions held in mid-window (every vehicle has asked by then, and none
-  // has left: the first workers delete their clients before the window's end).
+  // has left: the workers delete their clients once all results are in).
   if (!sleep_until_ns(start_ns + (end_ns - start_ns) / 2)) throw std::runtime_error("stopped by a signal");
   std::vector<double> vehicles_mid;
   for (int r = 0; metrics && r < services_n; ++r) {
@@ -600,6 +609,7 @@ int run_coordinator(const Options& o) {
       std::this_thread::sleep_for(50ms);
     }
   }
+  std::ofstream(dir.path() + "/leave") << "leave\n";
   std::printf(
       "worker %d: %s", firsts.front(),
       integration::read_file_tail(dir.path() + "/worker." + std::to_string(firsts.front()) + ".out", 2000).c_str());
@@ -611,6 +621,7 @@ int run_coordinator(const Options& o) {
       replies_after_drain.push_back(metric_sum(http_get(port_base + r, "/metrics"), "pullout_replies_total"));
   }
   std::vector<double> latencies;
+  std::vector<std::vector<double>> by_second;  // latencies by the second of the send window (lost: inf)
   std::vector<double> to_service_ms;    // send() -> the final status published
   std::vector<double> from_service_ms;  // published -> arrived
   std::size_t sent = 0;
@@ -638,7 +649,11 @@ int run_coordinator(const Options& o) {
         int planned = 0;
         double to_service = -1.0;
         double from_service = -1.0;
-        fields >> planned >> to_service >> from_service;
+        double sent_s = 0.0;
+        fields >> planned >> to_service >> from_service >> sent_s;
+        const auto second = static_cast<std::size_t>(std::clamp(sent_s, 0.0, 1e4));
+        if (by_second.size() <= second) by_second.resize(second + 1);
+        by_second[second].push_back(latency < 0 ? std::numeric_limits<double>::infinity() : latency);
         if (to_service >= 0.0 || from_service >= 0.0) {
           to_service_ms.push_back(to_service);
           from_service_ms.push_back(from_service);
@@ -695,6 +710,10 @@ int run_coordinator(const Options& o) {
   const pullout::bench::Summary from = pullout::bench::summarize(from_service_ms);
   std::printf("send -> final status published: p50 %.2f p99 %.2f ms; published -> arrived: p50 %.2f p99 %.2f ms\n",
               to.p50, to.p99, from.p50, from.p99);
+  // Where in the window the slow replies are (warm-up, a stall, or throughout).
+  std::printf("p99 [ms] by second of the send window:");
+  for (const std::vector<double>& second : by_second) std::printf(" %.0f", pullout::bench::summarize(second).p99);
+  std::printf("\n");
   if (metrics) {
     std::printf("replies published by the services after the drain: %.0f (requests answered: %zu)\n", replies_sum,
                 latencies.size());
