@@ -32,9 +32,9 @@ using pullout::kPi;
 
 using pullout::bench::box;
 
-// A square lot `size` m across: 0.4 m walls, rows of 2.7 m x 5.5 m bays (double rows between 7 m
-// aisles), 70 % of the bays holding a 4.6 m x 1.9 m car (as bench_freespace's lots).
-pullout::Costmap parking_lot(double size, double resolution, std::mt19937& rng) {
+// The obstacles of a square lot `size` m across: 0.4 m walls, rows of 2.7 m x 5.5 m bays (double
+// rows between 7 m aisles), 70 % of the bays holding a 4.6 m x 1.9 m car (as bench_freespace's lots).
+std::vector<pullout::Polygon> lot_obstacles(double size, std::mt19937& rng) {
   constexpr double kWall = 0.4, kBayW = 2.7, kBayD = 5.5, kAisle = 7.0;
   std::vector<pullout::Polygon> obstacles{
       box(size / 2, kWall / 2, 0, size, kWall), box(size / 2, size - kWall / 2, 0, size, kWall),
@@ -55,10 +55,18 @@ pullout::Costmap parking_lot(double size, double resolution, std::mt19937& rng) 
     y += depth + kAisle;
     single = false;
   }
+  return obstacles;
+}
+
+// An empty costmap of the lot's size.
+pullout::Costmap empty_lot(double size, double resolution) {
   const int cells = static_cast<int>(std::round(size / resolution));
-  pullout::Costmap map({0, 0, 0}, resolution, cells, cells,
-                       std::vector<std::uint8_t>(static_cast<std::size_t>(cells) * cells, 0));
-  map.add_obstacles(obstacles);
+  return {{0, 0, 0}, resolution, cells, cells, std::vector<std::uint8_t>(static_cast<std::size_t>(cells) * cells, 0)};
+}
+
+pullout::Costmap parking_lot(double size, double resolution, std::mt19937& rng) {
+  pullout::Costmap map = empty_lot(size, resolution);
+  map.add_obstacles(lot_obstacles(size, rng));
   return map;
 }
 
@@ -142,6 +150,24 @@ void BM_CostmapBuild(benchmark::State& state) {
   }
 }
 
+// The whole costmap build of a lot from its obstacle polygons (what a planning request pays):
+// the polygons rasterised with their exact layer (Costmap::add_obstacles: hard and partial cells),
+// then the tables. The empty map it starts from is made outside the timing.
+void BM_CostmapAddObstacles(benchmark::State& state) {
+  const double size = static_cast<double>(state.range(0));
+  const double resolution = static_cast<double>(state.range(1)) * 0.01;
+  std::mt19937 rng(static_cast<unsigned>(state.range(0) * 100 + state.range(1)));
+  const std::vector<pullout::Polygon> obstacles = lot_obstacles(size, rng);
+  for (auto _ : state) {
+    state.PauseTiming();
+    pullout::Costmap map = empty_lot(size, resolution);
+    state.ResumeTiming();
+    map.add_obstacles(obstacles);
+    benchmark::DoNotOptimize(map.centre_distance(0, 0));
+  }
+  state.counters["polygons"] = static_cast<double>(obstacles.size());
+}
+
 // Lot size [m] x resolution [cm].
 void lots(benchmark::internal::Benchmark* b) {
   for (const int size : {30, 100}) {
@@ -154,6 +180,7 @@ BENCHMARK_CAPTURE(BM_Collides, open, false)->Apply(lots);
 BENCHMARK_CAPTURE(BM_ClearanceBound, near, true)->Apply(lots);
 BENCHMARK_CAPTURE(BM_ClearanceBound, open, false)->Apply(lots);
 BENCHMARK(BM_CostmapBuild)->Apply(lots)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CostmapAddObstacles)->Apply(lots)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -622,8 +622,8 @@ int run_coordinator(const Options& o) {
   }
   std::vector<double> latencies;
   std::vector<std::vector<double>> by_second;  // latencies by the second of the send window (lost: inf)
-  std::vector<double> to_service_ms;    // send() -> the final status published
-  std::vector<double> from_service_ms;  // published -> arrived
+  std::vector<double> to_service_ms;           // send() -> the final status published
+  std::vector<double> from_service_ms;         // published -> arrived
   std::size_t sent = 0;
   std::size_t lost = 0;
   std::size_t not_planned = 0;

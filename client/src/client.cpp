@@ -60,6 +60,19 @@ constexpr auto kDispatchPeriod = std::chrono::milliseconds(1000);
 // Instances the shared endpoints of a ClientParticipant hold at least (one per vehicle on it).
 constexpr std::int32_t kSharedMaxInstances = 4096;
 
+// Room for every vehicle of the participant in a shared endpoint's QoS (a writer's or a reader's):
+// a profile's max_instances below kSharedMaxInstances is raised to it, with its depth per instance.
+template <class Qos>
+void widen_for_fleet(Qos& qos) {
+  auto& limits = qos.resource_limits();
+  if (limits.max_instances > 0 && limits.max_instances < kSharedMaxInstances) {
+    const int depth = std::max(1, qos.history().depth);
+    limits.max_instances = kSharedMaxInstances;
+    limits.max_samples_per_instance = depth;
+    limits.max_samples = kSharedMaxInstances * depth;
+  }
+}
+
 std::int64_t system_now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
@@ -592,13 +605,7 @@ void Hub::create() {
         qos = from_profile;
       }
     }
-    auto& limits = qos.resource_limits();
-    if (limits.max_instances > 0 && limits.max_instances < kSharedMaxInstances) {
-      const int depth = std::max(1, qos.history().depth);
-      limits.max_instances = kSharedMaxInstances;
-      limits.max_samples_per_instance = depth;
-      limits.max_samples = kSharedMaxInstances * depth;
-    }
+    widen_for_fleet(qos);
     return qos;
   };
   ep_.request_writer = ep_.publisher->create_datawriter(request_topic_, writer_qos(kRequestWriterProfile));
@@ -622,13 +629,7 @@ void Hub::create_readers(const std::vector<std::string>& parameters) {
         qos = from_profile;
       }
     }
-    auto& limits = qos.resource_limits();
-    if (limits.max_instances > 0 && limits.max_instances < kSharedMaxInstances) {
-      const int depth = std::max(1, qos.history().depth);
-      limits.max_instances = kSharedMaxInstances;
-      limits.max_samples_per_instance = depth;
-      limits.max_samples = kSharedMaxInstances * depth;
-    }
+    widen_for_fleet(qos);
     return qos;
   };
   const auto filtered_reader = [&](dds::Topic* topic, const char* profile, int depth,

@@ -29,6 +29,7 @@
 #include "pullout/maps/lanelet_map.hpp"
 #include "pullout/maps/osm_loader.hpp"
 #include "pullout/model/names.hpp"
+#include "pullout/process_heap.hpp"
 #include "pullout/version.hpp"
 #include "service/pullout_service.hpp"
 
@@ -109,6 +110,8 @@ int run(int argc, char** argv) {
     return kExitUsage;
   }
 
+  // Before any thread: the heap settings are process-wide (see process_heap.hpp).
+  const pullout::HeapTuning heap = pullout::tune_process_heap();
   const sigset_t stop_signals = block_stop_signals();
 
   pullout::Config config;
@@ -156,6 +159,18 @@ int run(int argc, char** argv) {
   if (domain_id >= 0) config.dds.domain_id = domain_id;
   if (!log_level.empty()) config.service.log_level = log_level;
   spdlog::set_level(spdlog::level::from_str(config.service.log_level));
+  switch (heap) {
+    case pullout::HeapTuning::kApplied:
+      spdlog::debug("heap: blocks up to {} MiB from the heap, up to {} MiB of free memory kept for reuse",
+                    pullout::kHeapMmapThresholdBytes >> 20, pullout::kHeapTrimThresholdBytes >> 20);
+      break;
+    case pullout::HeapTuning::kLeftToTunables:
+      spdlog::info("heap: GLIBC_TUNABLES sets glibc.malloc tunables: the heap is left as they say");
+      break;
+    case pullout::HeapTuning::kRefused:
+      spdlog::warn("heap: mallopt refused the settings (a sanitizer's allocator?): glibc's defaults apply");
+      break;
+  }
 
   try {
     pullout::service::PulloutService service(config, map);

@@ -175,6 +175,7 @@ bool Costmap::inside_drivable(const Vec2& p_G) const {
 bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& stop, std::size_t lane_edges) {
   std::vector<Vec2> g;
   std::vector<std::uint32_t> edge_cells;
+  std::vector<double> crossings;
   std::size_t count = 0;
   for (const Polygon& poly : polygons) {
     if (poly.empty()) continue;
@@ -227,25 +228,53 @@ bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& st
     // A lane edge decides the cells it crosses (their part outside the lanes is found by
     // inside_drivable), so those are partial even where the centre lies outside.
     const bool lane_edge = static_cast<std::size_t>(&poly - polygons.data()) < lane_edges;
-    cells_of(g.data(), g.size(), [&](int i, int j) {
-      const std::size_t c = index(i, j);
-      if (lane_edge) {
+    if (lane_edge) {
+      cells_of(g.data(), g.size(), [&](int i, int j) {
+        const std::size_t c = index(i, j);
         occupied_[c] = 1;
         hard_[c] = 0;
         partial_.emplace_back(static_cast<std::uint32_t>(c), shape);
-        return;
-      }
-      if (!std::binary_search(edge_cells.begin(), edge_cells.end(), static_cast<std::uint32_t>(c))) {
-        // No edge meets the cell's interior: it lies inside the polygon entirely (hard) or
-        // outside entirely (a concavity: left as it is).
-        if (!closed || !point_in_polygon(g, {i + 0.5, j + 0.5})) return;
-        occupied_[c] = 1;
-        hard_[c] = 1;
-        return;
-      }
+      });
+      continue;
+    }
+    // The cells an edge meets: partial (the exact test decides), unless already hard.
+    for (const std::uint32_t c : edge_cells) {
       occupied_[c] = 1;
-      if (hard_[c] == 0) partial_.emplace_back(static_cast<std::uint32_t>(c), shape);
-    });
+      if (hard_[c] == 0) partial_.emplace_back(c, shape);
+    }
+    if (!closed) continue;
+    // Every other cell lies entirely inside the polygon or entirely outside it: hard when its
+    // centre is inside. Per row, the crossings of the edges with the centres' height, with
+    // point_in_polygon's rule and arithmetic (so each centre gets exactly its answer): a centre is
+    // inside when an odd number of crossings lie to its right.
+    const int r0 = clamped_int(std::floor(y_lo), 0, height_);
+    const int r1 = clamped_int(std::floor(y_hi), -1, height_ - 1);
+    auto edge_it = edge_cells.begin();
+    for (int j = r0; j <= r1; ++j) {
+      const double y = j + 0.5;
+      crossings.clear();
+      for (std::size_t k = 0, m = g.size() - 1; k < g.size(); m = k++) {
+        const Vec2& a = g[k];
+        const Vec2& b = g[m];
+        if ((a.y() > y) != (b.y() > y)) crossings.push_back(a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y()));
+      }
+      std::sort(crossings.begin(), crossings.end());
+      const auto row_begin = static_cast<std::uint32_t>(index(0, j));
+      while (edge_it != edge_cells.end() && *edge_it < row_begin) ++edge_it;
+      // Centres x in [crossings[k], crossings[k + 1]) for even k have an odd count to their right.
+      for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
+        int i = clamped_int(std::ceil(crossings[k] - 0.5), 0, width_);
+        while (i > 0 && (i - 1) + 0.5 >= crossings[k]) --i;  // exact: the first centre at or right of it
+        while (i < width_ && i + 0.5 < crossings[k]) ++i;
+        for (; i < width_ && i + 0.5 < crossings[k + 1]; ++i) {
+          const auto c = static_cast<std::uint32_t>(index(i, j));
+          while (edge_it != edge_cells.end() && *edge_it < c) ++edge_it;
+          if (edge_it != edge_cells.end() && *edge_it == c) continue;  // an edge meets it: partial
+          occupied_[c] = 1;
+          hard_[c] = 1;
+        }
+      }
+    }
   }
   return true;
 }
