@@ -59,6 +59,25 @@ INSTANTIATE_TEST_SUITE_P(Bundled, PlanVerdict,
                          ::testing::Values("traffic_fast_from_behind", "traffic_far_behind", "traffic_cannot_pass",
                                            "map_traffic_fast_from_behind"));
 
+// `pullout plan` plans the scenario's own vehicle only; a fleet in the file is named on stderr,
+// not dropped without a word (and a scenario without one gets no note).
+TEST(PlanText, SaysThatTheFleetIsNotPlanned) {
+  const auto stderr_of = [](const std::string& scenario) {
+    const std::string command = std::string(PULLOUT_CLI_EXE) + " plan " + scenario_file(scenario) + " 2>&1 >/dev/null";
+    std::string err;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (pipe == nullptr) return err;
+    std::array<char, 4096> buffer{};
+    std::size_t n = 0;
+    while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) err.append(buffer.data(), n);
+    ::pclose(pipe);
+    return err;
+  };
+  EXPECT_NE(stderr_of("fleet_opposite_shoulders").find("the scenario's fleet (1 other vehicle) is not planned here"),
+            std::string::npos);
+  EXPECT_EQ(stderr_of("straight_shoulder").find("fleet"), std::string::npos);
+}
+
 TEST(PlanText, SaysUnsafeForAFastCarFromBehind) {
   const CliRun run = run_cli("plan " + scenario_file("traffic_fast_from_behind"));
   EXPECT_EQ(run.exit_code, 0);

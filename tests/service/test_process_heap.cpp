@@ -52,7 +52,8 @@ TEST_F(TunablesEnv, AnOperatorsMallocTunableIsLeftAlone) {
 
 TEST_F(TunablesEnv, OtherTunablesOrNoneApplyTheSettings) {
   // ASan's allocator has no mallopt settings: it refuses them, and the service says so.
-  const pullout::HeapTuning expected = kSanitizerAllocator ? pullout::HeapTuning::kRefused : pullout::HeapTuning::kApplied;
+  const pullout::HeapTuning expected =
+      kSanitizerAllocator ? pullout::HeapTuning::kRefused : pullout::HeapTuning::kApplied;
   ::setenv("GLIBC_TUNABLES", "glibc.rtld.nns=2", 1);
   EXPECT_EQ(pullout::tune_process_heap(), expected);
   ::unsetenv("GLIBC_TUNABLES");
