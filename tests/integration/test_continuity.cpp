@@ -123,65 +123,63 @@ std::optional<PullOutPath> wait_for_path_after(const Client& client, std::int64_
 
 class RestartWithoutLoss : public ::testing::Test {
  protected:
-  std::string config() {
-    return temp_.write_file("state.yaml", "service:\n  state_dir: " + temp_.path() +
+  // car_close_ahead (reverse, shift) planned for `vehicle` by a first service with a state
+  // directory, approved and driven to the end of segment 0; then that service is killed
+  // (SIGKILL, reaped). Check HasFatalFailure() after it.
+  void drive_first_segment_then_kill(const std::string& vehicle) {
+    cfg_ = temp_.write_file("state.yaml", "service:\n  state_dir: " + temp_.path() +
                                               "/state\ndds:\n  profiles_file: " + loopback_profiles_path() + "\n");
+    scenario_ = load_test_scenario("car_close_ahead");
+    client_ = client_on(lease_.domain(), vehicle);
+    ServiceProcess first(options_for(lease_.domain(), cfg_));
+    ASSERT_TRUE(client_->wait_for_service(kMatchTimeout));
+    id_ = client_->send(scenario_.request);
+    const auto path = client_->wait_for_path(id_, kReplyTimeout);
+    ASSERT_TRUE(path && path->found) << first.stderr_tail();
+    ASSERT_EQ(path->partial_paths.size(), 2u) << "reverse, shift";
+    path_ = *path;
+    driver_.emplace(*client_, id_, path_);
+    driver_->finish_first_segment();
+    if (HasFatalFailure()) return;
+    killed_ns_ = wall_ns();
+    ASSERT_EQ(::kill(first.pid(), SIGKILL), 0);
   }
+
   TempDir temp_;
   DomainLease lease_;
+  std::string cfg_;
+  Scenario scenario_;
+  std::unique_ptr<Client> client_;
+  std::uint64_t id_{0};
+  PullOutPath path_;
+  std::optional<Driver> driver_;  // after client_: destroyed first
+  std::int64_t killed_ns_{0};
 };
 
 TEST_F(RestartWithoutLoss, AVehicleInMidManoeuvreKeepsItsSegmentAndApprovalAcrossAKill) {
-  const std::string cfg = config();
-  const Scenario scenario = load_test_scenario("car_close_ahead");
-  auto client = client_on(lease_.domain(), "restart-mid");
-  std::optional<ServiceProcess> first;
-  first.emplace(options_for(lease_.domain(), cfg));
-  ASSERT_TRUE(client->wait_for_service(kMatchTimeout));
-  const std::uint64_t id = client->send(scenario.request);
-  const auto path = client->wait_for_path(id, kReplyTimeout);
-  ASSERT_TRUE(path && path->found) << first->stderr_tail();
-  ASSERT_EQ(path->partial_paths.size(), 2u) << "reverse, shift";
-  Driver driver(*client, id, *path);
-  driver.finish_first_segment();
+  drive_first_segment_then_kill("restart-mid");
   if (HasFatalFailure()) return;
-
-  const std::int64_t killed_ns = wall_ns();
-  ASSERT_EQ(::kill(first->pid(), SIGKILL), 0);
-  first.reset();  // reaps it
-  ServiceProcess second(options_for(lease_.domain(), cfg));
+  ServiceProcess second(options_for(lease_.domain(), cfg_));
 
   // The restarted service says it again, for the same request: segment 1, departed, executing.
-  const auto again = client->wait_for_status(
-      id, [&](const PullOutStatus& s) { return s.stamp_ns > killed_ns; }, kReplyTimeout);
+  const auto again = client_->wait_for_status(
+      id_, [&](const PullOutStatus& s) { return s.stamp_ns > killed_ns_; }, kReplyTimeout);
   ASSERT_TRUE(again) << second.stderr_tail();
-  EXPECT_EQ(again->request_id, id);
+  EXPECT_EQ(again->request_id, id_);
   EXPECT_EQ(again->current_path_idx, 1u);
   EXPECT_TRUE(again->departed);
   EXPECT_EQ(again->state, ExecutionState::kExecuting);
-  const auto republished = wait_for_path_after(*client, killed_ns);
+  const auto republished = wait_for_path_after(*client_, killed_ns_);
   ASSERT_TRUE(republished) << "the path was not published again\n" << second.stderr_tail();
-  expect_same_path(*republished, *path);
+  expect_same_path(*republished, path_);
   // No second approval, no restart from segment 0: it completes from where it was.
-  EXPECT_TRUE(driver.finish_last_segment()) << second.stderr_tail();
+  EXPECT_TRUE(driver_->finish_last_segment()) << second.stderr_tail();
   EXPECT_TRUE(second.stop().clean()) << second.stderr_tail();
 }
 
 TEST_F(RestartWithoutLoss, ACorruptStateFileIsIgnoredAndTheVehicleNeedsItsApprovalAgain) {
-  const std::string cfg = config();
-  const Scenario scenario = load_test_scenario("car_close_ahead");
-  auto client = client_on(lease_.domain(), "restart-corrupt");
-  std::optional<ServiceProcess> first;
-  first.emplace(options_for(lease_.domain(), cfg));
-  ASSERT_TRUE(client->wait_for_service(kMatchTimeout));
-  const std::uint64_t id = client->send(scenario.request);
-  const auto path = client->wait_for_path(id, kReplyTimeout);
-  ASSERT_TRUE(path && path->found) << first->stderr_tail();
-  Driver driver(*client, id, *path);
-  driver.finish_first_segment();
+  drive_first_segment_then_kill("restart-corrupt");
   if (HasFatalFailure()) return;
-  ASSERT_EQ(::kill(first->pid(), SIGKILL), 0);
-  first.reset();
 
   // One byte of the vehicle's state flipped in the middle (the checksum no longer matches), and
   // a file that is not a state file at all.
@@ -201,12 +199,12 @@ TEST_F(RestartWithoutLoss, ACorruptStateFileIsIgnoredAndTheVehicleNeedsItsApprov
   }
   temp_.write_file("state/00000000deadbeef.state", "garbage");
 
-  ServiceProcess second(options_for(lease_.domain(), cfg));
+  ServiceProcess second(options_for(lease_.domain(), cfg_));
   // Served afresh: a new request is planned and waits for approval, however the vehicle stands.
-  PullOutRequest next = scenario.request;
-  const std::uint64_t id2 = client->send(next);
-  ASSERT_NE(id2, id);
-  const auto waiting = client->wait_for_status(
+  PullOutRequest next = scenario_.request;
+  const std::uint64_t id2 = client_->send(next);
+  ASSERT_NE(id2, id_);
+  const auto waiting = client_->wait_for_status(
       id2, [](const PullOutStatus& s) { return s.state == ExecutionState::kWaitingApproval; }, kReplyTimeout);
   ASSERT_TRUE(waiting) << second.stderr_tail();
   EXPECT_FALSE(waiting->departed);
