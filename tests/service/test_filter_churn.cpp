@@ -51,10 +51,11 @@ constexpr auto kChurnTime = std::chrono::seconds(12);
 
 std::string vehicle_name(int i) { return "churn_" + std::to_string(i); }
 
-// A participant of filtered status readers, one per vehicle in [first, first + count).
-class FilteredReaders {
+// A participant with the vehicle filter factory, the status topic and a subscriber, and the
+// status reader profile's QoS: what the filtered readers below are made in.
+class StatusSubscriber {
  public:
-  FilteredReaders(int domain, int first, int count) {
+  explicit StatusSubscriber(int domain) {
     auto* factory = dds::DomainParticipantFactory::get_instance();
     participant_ = factory->create_participant_with_profile(domain, "pullout_participant");
     if (participant_ == nullptr) throw std::runtime_error("participant");
@@ -67,25 +68,39 @@ class FilteredReaders {
     topic_ = participant_->create_topic(idl::kStatusTopic, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
     subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
     if (topic_ == nullptr || subscriber_ == nullptr) throw std::runtime_error("topic/subscriber");
-    dds::DataReaderQos qos;
-    if (subscriber_->get_datareader_qos_from_profile(idl::kStatusReaderProfile, qos) != ReturnCode_t::RETCODE_OK) {
+    if (subscriber_->get_datareader_qos_from_profile(idl::kStatusReaderProfile, qos_) != ReturnCode_t::RETCODE_OK) {
       throw std::runtime_error("status reader profile");
     }
+  }
+  ~StatusSubscriber() {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+  StatusSubscriber(const StatusSubscriber&) = delete;
+  StatusSubscriber& operator=(const StatusSubscriber&) = delete;
+
+ protected:
+  idl::VehicleIdFilterFactory filters_;  // outlives the participant
+  dds::DomainParticipant* participant_{nullptr};
+  dds::Topic* topic_{nullptr};
+  dds::Subscriber* subscriber_{nullptr};
+  dds::DataReaderQos qos_;
+};
+
+// A participant of filtered status readers, one per vehicle in [first, first + count).
+class FilteredReaders : public StatusSubscriber {
+ public:
+  FilteredReaders(int domain, int first, int count) : StatusSubscriber(domain) {
     for (int i = first; i < first + count; ++i) {
       const std::string id = vehicle_name(i);
       dds::ContentFilteredTopic* filtered =
           participant_->create_contentfilteredtopic(std::string(idl::kStatusTopic) + "/" + id, topic_,
                                                     idl::kVehicleFilterExpression, {id}, idl::kVehicleFilterClass);
       if (filtered == nullptr) throw std::runtime_error("content filtered topic");
-      dds::DataReader* reader = subscriber_->create_datareader(filtered, qos);
+      dds::DataReader* reader = subscriber_->create_datareader(filtered, qos_);
       if (reader == nullptr) throw std::runtime_error("reader");
       readers_.push_back({id, reader, filtered});
     }
-  }
-
-  ~FilteredReaders() {
-    participant_->delete_contained_entities();
-    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
   }
 
   // Deletes every other reader now (each one leaves on its own, not with the participant).
@@ -123,10 +138,6 @@ class FilteredReaders {
     dds::DataReader* reader;
     dds::ContentFilteredTopic* filtered;
   };
-  idl::VehicleIdFilterFactory filters_;  // outlives the participant
-  dds::DomainParticipant* participant_{nullptr};
-  dds::Topic* topic_{nullptr};
-  dds::Subscriber* subscriber_{nullptr};
   std::vector<Reader> readers_;
 };
 
@@ -190,36 +201,15 @@ TEST(WriterFilterChurn, ReadersComingAndGoingWhileTheServicePublishesDoNotCrashI
 
 // One reader of statuses whose filter is a set of vehicles (a ClientParticipant's), changing its
 // set in place as its vehicles come and go.
-class SetReader {
+class SetReader : public StatusSubscriber {
  public:
-  explicit SetReader(int domain) {
-    auto* factory = dds::DomainParticipantFactory::get_instance();
-    participant_ = factory->create_participant_with_profile(domain, "pullout_participant");
-    if (participant_ == nullptr) throw std::runtime_error("participant");
-    if (participant_->register_content_filter_factory(idl::kVehicleFilterClass, &filters_) !=
-        ReturnCode_t::RETCODE_OK) {
-      throw std::runtime_error("filter factory");
-    }
-    dds::TypeSupport type(idl::make_guarded_type<msg::PullOutStatusPubSubType>());
-    type.register_type(participant_);
-    topic_ = participant_->create_topic(idl::kStatusTopic, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
-    subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
-    if (topic_ == nullptr || subscriber_ == nullptr) throw std::runtime_error("topic/subscriber");
-    dds::DataReaderQos qos;
-    if (subscriber_->get_datareader_qos_from_profile(idl::kStatusReaderProfile, qos) != ReturnCode_t::RETCODE_OK) {
-      throw std::runtime_error("status reader profile");
-    }
+  explicit SetReader(int domain) : StatusSubscriber(domain) {
     filtered_ =
         participant_->create_contentfilteredtopic(std::string(idl::kStatusTopic) + "/set", topic_,
                                                   idl::kVehicleSetFilterExpression, {}, idl::kVehicleFilterClass);
     if (filtered_ == nullptr) throw std::runtime_error("content filtered topic");
-    reader_ = subscriber_->create_datareader(filtered_, qos);
+    reader_ = subscriber_->create_datareader(filtered_, qos_);
     if (reader_ == nullptr) throw std::runtime_error("reader");
-  }
-
-  ~SetReader() {
-    participant_->delete_contained_entities();
-    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
   }
 
   bool set(const std::vector<std::string>& ids) {
@@ -238,10 +228,6 @@ class SetReader {
   }
 
  private:
-  idl::VehicleIdFilterFactory filters_;  // outlives the participant
-  dds::DomainParticipant* participant_{nullptr};
-  dds::Topic* topic_{nullptr};
-  dds::Subscriber* subscriber_{nullptr};
   dds::ContentFilteredTopic* filtered_{nullptr};
   dds::DataReader* reader_{nullptr};
 };
