@@ -10,10 +10,11 @@
 // apart) at its closest point; `slack` is the sum of the closest distances from the body to the
 // car ahead and to the car behind, half each. On a straight street that is the lateral gap and
 // the gaps along the street; on a bend a straight car tangent to the curve at its rear axle comes
-// closer to an outer kerb at its front corner (0.23 m closer at R 30 m: a car placed "0.15 m"
-// from it by its rear axle overlaps the kerb), and gaps measured in the road centerline's arc
-// length shrink inside the bend and grow outside it; so both are solved for here (bisection on the
-// true distances), not set by arc length. Lanes, cars and distances are plain geometry written
+// closer to an outer kerb at its front corner (0.21 m closer at R 30 m: a car placed "0.15 m"
+// from it by its rear axle overlaps the kerb by 0.06 m), and gaps set in the road centerline's
+// arc length shrink inside the bend and grow outside it (at R 30 m and 1.0 m of slack: 0.05 and
+// 0.06 m inside instead of 0.5 m, 1.09 and 0.83 m outside); so both are solved for here
+// (bisection on the true distances). Lanes, cars and distances are plain geometry written
 // here and in path_oracles.hpp, not the planners' code.
 #pragma once
 
@@ -155,7 +156,7 @@ inline Street make_street(const Spot& sp, const VehicleInfo& v, const std::strin
   // (the distance grows with |s - kEgoS| beyond contact), by bisection.
   const auto place = [&](double dir) {
     const double touching = dir > 0.0 ? v.base_to_front_m() + kCarLength / 2 : v.base_to_rear_m() + kCarLength / 2;
-    double lo = kEgoS + dir * 0.5 * touching;          // overlapping
+    double lo = kEgoS + dir * 0.5 * touching;               // overlapping
     double hi = kEgoS + dir * (touching + sp.slack + 5.0);  // beyond the gap
     for (int i = 0; i < 60; ++i) {
       const double mid = 0.5 * (lo + hi);

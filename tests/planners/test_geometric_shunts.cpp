@@ -66,7 +66,9 @@ int direction_changes(const PullOutPath& path) {
 }
 
 // The oracles' verdict on a found path; empty when it is drivable.
-std::string check_path(const PullOutPath& path, const Street& st, const VehicleInfo& v, double margin) {
+// `radius`: of the street's bend (0: straight), for where the road centerline is at the end.
+std::string check_path(const PullOutPath& path, const Street& st, const VehicleInfo& v, double margin,
+                       double radius = 0.0) {
   const auto& segs = path.partial_paths;
   if (segs.empty()) return "no partial paths";
   if (path.pairs_terminal_velocity_and_accel.size() != segs.size()) return "pairs and partial paths differ in number";
@@ -105,7 +107,15 @@ std::string check_path(const PullOutPath& path, const Street& st, const VehicleI
     }
   }
   const Pose2 end = path.end_pose;
-  if (std::abs(end.y - st.road_y) > 0.05 || std::abs(std::remainder(end.yaw, kTwoPi)) > 0.02) {
+  if (radius > 0.0) {
+    // On the bend (centre (0, radius), curving left): the centerline is the circle of radius
+    // `radius` - road_y, its heading the polar angle from the centre's bottom.
+    const double off = std::hypot(end.x, end.y - radius) - (radius - st.road_y);
+    const double yaw = std::atan2(end.x, radius - end.y);
+    if (std::abs(off) > 0.05 || std::abs(std::remainder(end.yaw - yaw, kTwoPi)) > 0.02) {
+      return "does not end on the road lane's centerline";
+    }
+  } else if (std::abs(end.y - st.road_y) > 0.05 || std::abs(std::remainder(end.yaw, kTwoPi)) > 0.02) {
     return "does not end on the road lane's centerline";
   }
   return "";
@@ -163,7 +173,7 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
 // closest point and inside the raw lane polygons, and the cars are slack / 2 from it. Before, a
 // car tangent to a 30 m bend at its rear axle, "0.15 m" from the outer kerb there, overlapped the
 // kerb with its front corner (the start itself was invalid), and gaps set in centerline arc length
-// were 12 % short inside the bend.
+// were 0.05 m instead of 0.5 m inside the bend at 1.0 m of slack.
 TEST(GeometricShunts, GeneratedSpotsOnBendsHaveTheirKerbDistanceAndSlack) {
   const VehicleInfo v;
   const Footprint body{v.base_to_front_m(), v.base_to_rear_m(), v.base_to_left_m(), v.base_to_right_m()};
@@ -187,6 +197,36 @@ TEST(GeometricShunts, GeneratedSpotsOnBendsHaveTheirKerbDistanceAndSlack) {
       }
     }
   }
+}
+
+// On bends (the parking lane outside a left bend for right-hand traffic, inside it for
+// left-hand), two road lanes, 0.3 and 0.5 m from the kerb, 1.0 to 3.0 m of slack: every spot is
+// left, every path passes the oracles. With the old generator (gaps set in centerline arc length)
+// the inside of the 30 m bend had far less room than its nominal slack (0.05 m instead of 0.5 m
+// at 1.0 m) and its 1.0-1.5 m spots were not left; with true closest distances they are.
+TEST(GeometricShunts, LeavesSpotsOnBendsWithAMetreOfSlack) {
+  const VehicleInfo v;
+  const StartPlannerParameters p = shipped_without_freespace();
+  const StartPlanner planner(v, p);
+  const double margin = smallest_margin(p);
+  int spots = 0;
+  for (bool right_hand : {true, false}) {
+    for (double radius : {30.0, 100.0}) {
+      for (double kerb : {0.3, 0.5}) {
+        for (double slack : {3.0, 2.0, 1.5, 1.0}) {
+          const Spot s{right_hand, 2, kerb, slack, radius};
+          const Street st = make_spot(s, v);
+          const PlanningResult r = planner.plan(st.request, StopCondition());
+          ++spots;
+          ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound)
+              << s << ": no path: " << r.stop_reason << (r.path.reasons.empty() ? "" : " / " + r.path.reasons.front());
+          const std::string verdict = check_path(r.path, st, v, margin, radius);
+          EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(spots, 32);
 }
 
 // The same spots with shunting off: the tight ones are not left (what the shunts add), so the
