@@ -7,7 +7,9 @@
 // direction changes of the paths, planning time p50 / p95. Every path found is checked by the
 // independent oracles (tests/planners/path_oracles.hpp): the bare body inside the raw lane
 // polygons and clear of both cars at poses every 5 cm, velocity 0 at each change of direction, one
-// pair per partial path; a path that fails them counts as not solved (and is reported).
+// pair per partial path; a path that fails them counts as not solved (and is reported). The
+// spots come from tests/planners/street_spots.hpp (shared with the shunting tests): "kerb" and
+// "slack" are the body's closest distances to the kerb and to the two cars, also on a bend.
 //
 //   build/bench/bench_street_spots
 //
@@ -29,90 +31,14 @@
 #include "percentiles.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
+#include "street_spots.hpp"
 
 namespace {
 
 using namespace pullout;  // NOLINT: a benchmark's main file
 
-constexpr double kLaneWidth = 3.5;
-constexpr double kParkingWidth = 3.0;
-constexpr double kStreetLength = 120.0;
-constexpr double kEgoS = 40.0;
-
-struct Spot {
-  bool right_hand;
-  int road_lanes;
-  double radius;  // 0: straight
-  double kerb;
-  double slack;
-};
-
-// The street frame (s along the road centerline of the vehicle's lane, y to its left) to the map.
-Pose2 at(const Spot& sp, double s, double y) {
-  if (sp.radius <= 0.0) return {s, y, 0.0};
-  const double th = s / sp.radius;
-  return {(sp.radius - y) * std::sin(th), sp.radius - (sp.radius - y) * std::cos(th), th};
-}
-
-std::vector<Point2> line(const Spot& sp, double y) {
-  std::vector<Point2> out;
-  for (double s = 0.0; s <= kStreetLength + 1e-9; s += 1.0) {
-    const Pose2 p = at(sp, s, y);
-    out.push_back({p.x, p.y});
-  }
-  return out;
-}
-
-Lane lane(const Spot& sp, std::int64_t id, LaneSubtype subtype, double y_right, double y_left) {
-  Lane l;
-  l.id = id;
-  l.subtype = subtype;
-  l.left_bound = line(sp, y_left);
-  l.right_bound = line(sp, y_right);
-  l.speed_limit_mps = 8.33;
-  return l;
-}
-
-struct Street {
-  PullOutRequest request;
-  std::vector<Polygon> lanes;
-  std::vector<Polygon> cars;
-};
-
-Street make_street(const Spot& sp, const VehicleInfo& v) {
-  Street st;
-  PullOutRequest& r = st.request;
-  r.vehicle_id = "spot";
-  r.request_id = 1;
-  const double h = kLaneWidth / 2;
-  const double side = sp.right_hand ? -1.0 : 1.0;  // where the parking lane is
-  r.lanes.push_back(lane(sp, 1, LaneSubtype::kRoad, -h, h));
-  if (sp.road_lanes == 2) {
-    r.lanes.push_back(sp.right_hand ? lane(sp, 3, LaneSubtype::kRoad, h, h + kLaneWidth)
-                                    : lane(sp, 3, LaneSubtype::kRoad, -h - kLaneWidth, -h));
-  }
-  r.lanes.push_back(sp.right_hand ? lane(sp, 2, LaneSubtype::kRoadShoulder, -h - kParkingWidth, -h)
-                                  : lane(sp, 2, LaneSubtype::kRoadShoulder, h, h + kParkingWidth));
-  const double kerb_y = side * (h + kParkingWidth);
-  const double y = sp.right_hand ? kerb_y + sp.kerb + v.base_to_right_m() : kerb_y - sp.kerb - v.base_to_left_m();
-  r.ego_pose = at(sp, kEgoS, y);
-  r.goal_pose = at(sp, 110.0, 0.0);
-  const double half = sp.slack / 2;
-  const double s_ahead = kEgoS + v.base_to_front_m() + half + 2.25;
-  const double s_behind = kEgoS - v.base_to_rear_m() - half - 2.25;
-  for (auto [id, s] : {std::pair<std::int64_t, double>{7, s_ahead}, {8, s_behind}}) {
-    Object o;
-    o.id = id;
-    o.object_class = ObjectClass::kCar;
-    o.pose = at(sp, s, y);
-    o.length_m = 4.5;
-    o.width_m = 1.9;
-    r.objects.push_back(o);
-    st.cars.push_back(object_polygon(o));
-  }
-  for (const Lane& l : r.lanes) st.lanes.push_back(oracle::lane_polygon(l));
-  return st;
-}
+using street::Spot;
+using street::Street;
 
 // Empty when the path passes the oracles.
 std::string check(const PullOutPath& path, const Street& st, const VehicleInfo& v) {
@@ -195,8 +121,8 @@ int main(int argc, char** argv) {
                                    (radius > 0 ? "R " + std::to_string(static_cast<int>(radius)) + " m" : "straight");
         for (double kerb : {0.15, 0.3, 0.5}) {
           for (double slack : {3.0, 2.0, 1.5, 1.0, 0.8}) {
-            const Spot sp{right_hand, road_lanes, radius, kerb, slack};
-            const Street st = make_street(sp, v);
+            const Spot sp{right_hand, road_lanes, kerb, slack, radius};
+            const Street st = street::make_street(sp, v);
             for (const Planner& pl : planners) {
               const StartPlanner planner(v, pl.params);
               const auto t0 = std::chrono::steady_clock::now();

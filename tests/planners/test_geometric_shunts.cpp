@@ -30,72 +30,22 @@
 #include "path_oracles.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
-#include "test_world.hpp"
+#include "street_spots.hpp"
 
 namespace pullout {
 namespace {
 
-constexpr double kLaneWidth = 3.5;       // [m] road lanes
-constexpr double kParkingWidth = 3.0;    // [m]
-constexpr double kStreetLength = 120.0;  // [m] x in [0, 120]
-constexpr double kEgoX = 40.0;
-constexpr double kCarLength = 4.5;
-constexpr double kCarWidth = 1.9;
+using street::kLaneWidth;
+using street::Spot;
+using street::Street;
+constexpr double kEgoX = street::kEgoS;  // on a straight street s is x
 // [m] Shunting moves have points every 10 cm: a pose interpolated on a chord of a 5 m arc lies
 // within 0.1^2 / (8 * 5) = 0.25 mm of it; the S has points every arc_path_interval (1 m):
 // within 1^2 / (8 * 5) = 2.5 cm.
 constexpr double kChordTolerance = 0.03;
 constexpr double kJoinTolerance = 0.01;  // [m] end of one partial path to the start of the next
 
-struct Spot {
-  bool right_hand;
-  int road_lanes;
-  double kerb;   // [m] from the vehicle's kerb-side edge to the kerb
-  double slack;  // [m] free ahead and behind together
-};
-
-std::ostream& operator<<(std::ostream& os, const Spot& s) {
-  return os << (s.right_hand ? "right-hand" : "left-hand") << ", " << s.road_lanes << " road lane(s), kerb " << s.kerb
-            << " m, slack " << s.slack << " m";
-}
-
-struct Street {
-  PullOutRequest request;
-  std::vector<Polygon> lanes;
-  std::vector<Polygon> cars;
-  double road_y{0.0};  // centerline of the vehicle's road lane
-};
-
-Street make_street(const Spot& s, const VehicleInfo& v) {
-  Street st;
-  PullOutRequest& r = st.request;
-  r.vehicle_id = "shunt";
-  r.request_id = 1;
-  const double h = kLaneWidth / 2;
-  r.lanes.push_back(test::straight_lane(1, LaneSubtype::kRoad, 0, kStreetLength, -h, h, 8.33));
-  if (s.road_lanes == 2) {
-    r.lanes.push_back(s.right_hand
-                          ? test::straight_lane(3, LaneSubtype::kRoad, 0, kStreetLength, h, h + kLaneWidth, 8.33)
-                          : test::straight_lane(3, LaneSubtype::kRoad, 0, kStreetLength, -h - kLaneWidth, -h, 8.33));
-  }
-  const double kerb_y = s.right_hand ? -h - kParkingWidth : h + kParkingWidth;
-  r.lanes.push_back(s.right_hand
-                        ? test::straight_lane(2, LaneSubtype::kRoadShoulder, 0, kStreetLength, kerb_y, -h, 8.33)
-                        : test::straight_lane(2, LaneSubtype::kRoadShoulder, 0, kStreetLength, h, kerb_y, 8.33));
-  const double y = s.right_hand ? kerb_y + s.kerb + v.base_to_right_m() : kerb_y - s.kerb - v.base_to_left_m();
-  r.ego_pose = {kEgoX, y, 0.0};
-  r.goal_pose = {110.0, 0.0, 0.0};
-  const double x_ahead = kEgoX + v.base_to_front_m() + s.slack / 2 + kCarLength / 2;
-  const double x_behind = kEgoX - v.base_to_rear_m() - s.slack / 2 - kCarLength / 2;
-  r.objects = {test::parked_car(7, x_ahead, y), test::parked_car(8, x_behind, y)};
-  for (const Object& o : r.objects) {
-    const double c = kCarLength / 2;
-    const double w = kCarWidth / 2;
-    st.cars.push_back(oracle::rectangle_at(c, c, w, w, o.pose));
-  }
-  for (const Lane& l : r.lanes) st.lanes.push_back(oracle::lane_polygon(l));
-  return st;
-}
+Street make_spot(const Spot& s, const VehicleInfo& v) { return street::make_street(s, v, "shunt"); }
 
 StartPlannerParameters shipped_without_freespace() {
   StartPlannerParameters p;
@@ -116,7 +66,9 @@ int direction_changes(const PullOutPath& path) {
 }
 
 // The oracles' verdict on a found path; empty when it is drivable.
-std::string check_path(const PullOutPath& path, const Street& st, const VehicleInfo& v, double margin) {
+// `radius`: of the street's bend (0: straight), for where the road centerline is at the end.
+std::string check_path(const PullOutPath& path, const Street& st, const VehicleInfo& v, double margin,
+                       double radius = 0.0) {
   const auto& segs = path.partial_paths;
   if (segs.empty()) return "no partial paths";
   if (path.pairs_terminal_velocity_and_accel.size() != segs.size()) return "pairs and partial paths differ in number";
@@ -155,7 +107,15 @@ std::string check_path(const PullOutPath& path, const Street& st, const VehicleI
     }
   }
   const Pose2 end = path.end_pose;
-  if (std::abs(end.y - st.road_y) > 0.05 || std::abs(std::remainder(end.yaw, kTwoPi)) > 0.02) {
+  if (radius > 0.0) {
+    // On the bend (centre (0, radius), curving left): the centerline is the circle of radius
+    // `radius` - road_y, its heading the polar angle from the centre's bottom.
+    const double off = std::hypot(end.x, end.y - radius) - (radius - st.road_y);
+    const double yaw = std::atan2(end.x, radius - end.y);
+    if (std::abs(off) > 0.05 || std::abs(std::remainder(end.yaw - yaw, kTwoPi)) > 0.02) {
+      return "does not end on the road lane's centerline";
+    }
+  } else if (std::abs(end.y - st.road_y) > 0.05 || std::abs(std::remainder(end.yaw, kTwoPi)) > 0.02) {
     return "does not end on the road lane's centerline";
   }
   return "";
@@ -184,7 +144,7 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   int found_unclaimed = 0;
   int most_changes = 0;
   for (const Spot& s : family()) {
-    const Street st = make_street(s, v);
+    const Street st = make_spot(s, v);
     const PlanningResult r = planner.plan(st.request, StopCondition());
     const bool found = r.outcome == PlanningResult::Outcome::kFound;
     if (found) {
@@ -209,6 +169,66 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   EXPECT_GE(most_changes, 3);
 }
 
+// The generator (street_spots.hpp) on bends: the body is `kerb` from the kerb polyline at its
+// closest point and inside the raw lane polygons, and the cars are slack / 2 from it. Before, a
+// car tangent to a 30 m bend at its rear axle, "0.15 m" from the outer kerb there, overlapped the
+// kerb with its front corner (the start itself was invalid), and gaps set in centerline arc length
+// were 0.05 m instead of 0.5 m inside the bend at 1.0 m of slack.
+TEST(GeometricShunts, GeneratedSpotsOnBendsHaveTheirKerbDistanceAndSlack) {
+  const VehicleInfo v;
+  const Footprint body{v.base_to_front_m(), v.base_to_rear_m(), v.base_to_left_m(), v.base_to_right_m()};
+  for (bool right_hand : {true, false}) {
+    for (double radius : {30.0, 100.0}) {
+      const Spot s{right_hand, 1, 0.15, 1.0, radius};
+      const Street st = make_spot(s, v);
+      EXPECT_NEAR(st.kerb_gap, 0.15, 1e-3) << s;
+      EXPECT_NEAR(st.gap_ahead, 0.5, 1e-3) << s;
+      EXPECT_NEAR(st.gap_behind, 0.5, 1e-3) << s;
+      EXPECT_TRUE(oracle::footprint_in_lanes(body, st.request.ego_pose, st.lanes)) << s;
+      // Outside the bend the body's farthest point from the bend's centre is a corner on the kerb
+      // side: (R + |y_edge|, front) from the centre, at the kerb radius less 0.15 m.
+      if (right_hand) {
+        const double kerb_r = radius + street::kLaneWidth / 2 + street::kParkingWidth;
+        const Pose2& q = st.request.ego_pose;
+        const double axle_r = std::hypot(q.x, q.y - radius);
+        const double corner_r = std::hypot(axle_r + v.base_to_right_m(), v.base_to_front_m());
+        // The kerb polyline's chords (1 m) lie up to 1 / (8 R) inside its circle.
+        EXPECT_NEAR(kerb_r - corner_r, 0.15, 1.0 / (8.0 * kerb_r) + 1e-3) << s;
+      }
+    }
+  }
+}
+
+// On bends (the parking lane outside a left bend for right-hand traffic, inside it for
+// left-hand), two road lanes, 0.3 and 0.5 m from the kerb, 1.0 to 3.0 m of slack: every spot is
+// left, every path passes the oracles. With the old generator (gaps set in centerline arc length)
+// the inside of the 30 m bend had far less room than its nominal slack (0.05 m instead of 0.5 m
+// at 1.0 m) and its 1.0-1.5 m spots were not left; with true closest distances they are.
+TEST(GeometricShunts, LeavesSpotsOnBendsWithAMetreOfSlack) {
+  const VehicleInfo v;
+  const StartPlannerParameters p = shipped_without_freespace();
+  const StartPlanner planner(v, p);
+  const double margin = smallest_margin(p);
+  int spots = 0;
+  for (bool right_hand : {true, false}) {
+    for (double radius : {30.0, 100.0}) {
+      for (double kerb : {0.3, 0.5}) {
+        for (double slack : {3.0, 2.0, 1.5, 1.0}) {
+          const Spot s{right_hand, 2, kerb, slack, radius};
+          const Street st = make_spot(s, v);
+          const PlanningResult r = planner.plan(st.request, StopCondition());
+          ++spots;
+          ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound)
+              << s << ": no path: " << r.stop_reason << (r.path.reasons.empty() ? "" : " / " + r.path.reasons.front());
+          const std::string verdict = check_path(r.path, st, v, margin, radius);
+          EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(spots, 32);
+}
+
 // The same spots with shunting off: the tight ones are not left (what the shunts add), so the
 // family above does test them.
 TEST(GeometricShunts, WithoutShuntsTheTightSpotsHaveNoPath) {
@@ -218,7 +238,7 @@ TEST(GeometricShunts, WithoutShuntsTheTightSpotsHaveNoPath) {
   const StartPlanner planner(v, p);
   for (bool right_hand : {true, false}) {
     const Spot s{right_hand, 1, 0.3, 1.0};
-    const PlanningResult r = planner.plan(make_street(s, v).request, StopCondition());
+    const PlanningResult r = planner.plan(make_spot(s, v).request, StopCondition());
     EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath) << s;
   }
 }
@@ -229,7 +249,7 @@ TEST(GeometricShunts, PairsFollowTheDirectionOfEachPartialPath) {
   const VehicleInfo v;
   const StartPlanner planner(v, shipped_without_freespace());
   const Spot s{true, 2, 0.3, 1.0};
-  const PlanningResult r = planner.plan(make_street(s, v).request, StopCondition());
+  const PlanningResult r = planner.plan(make_spot(s, v).request, StopCondition());
   ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
   EXPECT_EQ(r.path.planner_type, PlannerType::kGeometric);
   ASSERT_EQ(r.path.pairs_terminal_velocity_and_accel.size(), r.path.partial_paths.size());
@@ -254,7 +274,7 @@ TEST(GeometricShunts, NoRoomForTheMarginIsAClearNoPath) {
   const double slack = 2.0 * smallest_margin(p) - 0.02;
   for (bool right_hand : {true, false}) {
     const Spot s{right_hand, 2, 0.3, slack};
-    const PlanningResult r = planner.plan(make_street(s, v).request, StopCondition());
+    const PlanningResult r = planner.plan(make_spot(s, v).request, StopCondition());
     ASSERT_EQ(r.outcome, PlanningResult::Outcome::kNoPath) << s;
     EXPECT_FALSE(r.timed_out);
     EXPECT_FALSE(r.path.found);
@@ -272,7 +292,7 @@ TEST(GeometricShunts, BlockedRoadIsAClearNoPathNamingTheShunts) {
   const VehicleInfo v;
   const StartPlanner planner(v, shipped_without_freespace());
   const Spot s{true, 1, 0.3, 1.0};
-  Street st = make_street(s, v);
+  Street st = make_spot(s, v);
   Object barrier;
   barrier.id = 99;
   barrier.pose = {kEgoX + 22.0, 0.0, 0.0};
