@@ -7,10 +7,11 @@
 //   on_result (the safety verdict at the start) -> the path and status to publish, converted with
 //   idl::to_msg and serialized with the guarded type support (what the writers do).
 //
-// The planner has the shipped parameters (config/pullout.yaml) and the project's Lanelet2 map
-// (tests/maps/straight_shoulder.osm), so that route requests are planned too. A crash, a sanitizer
-// report or an exception escaping is a defect; so is an input whose handling takes more than
-// libFuzzer's -timeout (scripts/fuzz: 1 s), since the search is bounded by kDeadlineMs.
+// The planner has the shipped parameters and vehicle profiles (config/pullout.yaml: a request may
+// name the van or the bus) and the project's Lanelet2 map (tests/maps/straight_shoulder.osm), so
+// that route requests are planned too. A crash, a sanitizer report or an exception escaping is a
+// defect; so is an input whose handling takes more than libFuzzer's -timeout (scripts/fuzz: 1 s),
+// since the search is bounded by kDeadlineMs.
 // With PULLOUT_FUZZ_VERBOSE set, each input's outcome is printed (to read a reproducer).
 #include <chrono>
 #include <cstddef>
@@ -45,7 +46,8 @@ struct Fixture {
   Fixture()
       : config(pullout::load_config(PULLOUT_SOURCE_DIR "/config/pullout.yaml")),
         planner(config.vehicle, config.start_planner, config.service.limits,
-                pullout::load_lanelet_map(PULLOUT_SOURCE_DIR "/tests/maps/straight_shoulder.osm")) {}
+                pullout::load_lanelet_map(PULLOUT_SOURCE_DIR "/tests/maps/straight_shoulder.osm"),
+                config.vehicle_profiles) {}
 
   pullout::Config config;
   pullout::StartPlanner planner;

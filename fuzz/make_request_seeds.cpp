@@ -4,10 +4,14 @@
 //
 //   make_request_seeds <output dir> <scenario files...>
 //
-// Each scenario gives <stem>.cdr (its request, as `pullout request` sends it). A few bad requests
+// Each scenario gives <stem>.cdr (its request, as `pullout request` sends it); a scenario with a
+// route of lanelet ids also gives <stem>_route_segments.cdr (the same route as an Autoware route's
+// segments). The newer request fields get seeds of their own: vehicle_profile_bus.cdr (a profile of
+// the shipped config) and vehicle_own_dimensions.cdr (the vehicle's own dimensions). A few bad requests
 // follow, named bad_*.cdr: lanes 20 km across and 1e7 m long, coordinates of 1e20, the objects
 // limit reached and exceeded, a lane of 2,000 points, NaN and non-unit orientations, a grid whose
-// cell count disagrees with its size, a huge deadline, and two hand-made CDR streams (a sequence
+// cell count disagrees with its size, a huge deadline, a vehicle with a negative wheel base and one
+// named by a profile and given dimensions at once, and two hand-made CDR streams (a sequence
 // length of 2^31 - 1 with nothing behind it, and a truncated encoding). The seeds are committed
 // (fuzz/corpus/request/); scripts/fuzz --seeds regenerates them.
 #include <cmath>
@@ -85,6 +89,17 @@ Object car(std::int64_t id, double x, double y) {
   return o;
 }
 
+// The requests of the newer fields that no scenario carries: a vehicle by profile, and by its own
+// dimensions (the bus's: planned with a longer and wider footprint than the default car).
+void write_vehicle_requests(const fs::path& dir) {
+  PullOutRequest by_profile = base_request("vehicle-profile");
+  by_profile.vehicle_profile = "bus";
+  write(dir / "vehicle_profile_bus.cdr", encode(pullout::idl::to_msg(by_profile)));
+  PullOutRequest own = base_request("vehicle-own");
+  own.vehicle = pullout::default_vehicle_profiles().at("bus");
+  write(dir / "vehicle_own_dimensions.cdr", encode(pullout::idl::to_msg(own)));
+}
+
 void write_bad_requests(const fs::path& dir) {
   {  // two 2-point bounds 20 km across: a 20 km x 20 km road with the ego in it
     PullOutRequest r = base_request("bad-lane-20km");
@@ -154,6 +169,19 @@ void write_bad_requests(const fs::path& dir) {
     r.deadline_ms = 1e300;
     write(dir / "bad_deadline_huge.cdr", encode(pullout::idl::to_msg(r)));
   }
+  {  // own dimensions with a negative wheel base
+    PullOutRequest r = base_request("bad-vehicle");
+    pullout::VehicleInfo vehicle = pullout::default_vehicle_profiles().at("van");
+    vehicle.wheel_base_m = -3.0;
+    r.vehicle = vehicle;
+    write(dir / "bad_vehicle_dimensions.cdr", encode(pullout::idl::to_msg(r)));
+  }
+  {  // a profile and own dimensions at once (one or the other)
+    PullOutRequest r = base_request("bad-vehicle-both");
+    r.vehicle_profile = "bus";
+    r.vehicle = pullout::default_vehicle_profiles().at("bus");
+    write(dir / "bad_vehicle_profile_and_dimensions.cdr", encode(pullout::idl::to_msg(r)));
+  }
   {  // a header and vehicle id, then a lanes sequence length of 2^31 - 1 with no elements behind it
     std::vector<char> buffer(256, 0);
     eprosima::fastcdr::FastBuffer fast(buffer.data(), buffer.size());
@@ -184,8 +212,16 @@ int main(int argc, char** argv) {
     fs::create_directories(dir);
     for (int i = 2; i < argc; ++i) {
       const pullout::Scenario scenario = pullout::load_scenario(argv[i]);
-      write(dir / (fs::path(argv[i]).stem().string() + ".cdr"), encode(pullout::idl::to_msg(scenario.request)));
+      const std::string stem = fs::path(argv[i]).stem().string();
+      write(dir / (stem + ".cdr"), encode(pullout::idl::to_msg(scenario.request)));
+      if (!scenario.request.route_lanelet_ids.empty()) {
+        PullOutRequest segments = scenario.request;
+        for (const std::int64_t id : segments.route_lanelet_ids) segments.route_segments.push_back({id, {id}});
+        segments.route_lanelet_ids.clear();
+        write(dir / (stem + "_route_segments.cdr"), encode(pullout::idl::to_msg(segments)));
+      }
     }
+    write_vehicle_requests(dir);
     write_bad_requests(dir);
   } catch (const std::exception& e) {
     std::cerr << "make_request_seeds: " << e.what() << "\n";

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "json_output.hpp"
+#include "open_endpoint.hpp"
 #include "pullout/client/client.hpp"
 #include "pullout/config/config.hpp"
 #include "pullout/config/scenario.hpp"
@@ -167,15 +168,7 @@ int run_request(const RequestOptions& options, std::ostream& out, std::ostream& 
   client_options.profiles_file = options.profiles_file;
   client_options.security_dir = options.security_dir;
   std::optional<Client> client;
-  try {
-    client.emplace(client_options);
-  } catch (const std::invalid_argument& e) {
-    err << "pullout: " << e.what() << '\n';
-    return kExitBadInput;
-  } catch (const ClientError& e) {
-    err << "pullout: DDS setup failed: " << e.what() << '\n';
-    return kExitCommunication;
-  }
+  if (const auto failed = open_endpoint<ClientError>(client, client_options, err)) return *failed;
 
   const bool matched = wait_sliced(deadline, [&](Client::Duration slice) { return client->wait_for_service(slice); });
   if (g_interrupted.load()) return kExitInterrupted;

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "fleet_monitor.hpp"
 #include "fleet_view.hpp"
+#include "open_endpoint.hpp"
 #include "pullout/config/config.hpp"
 #include "view/view_server.hpp"
 
@@ -40,21 +41,6 @@ std::string header(const WatchOptions& options, const FleetSnapshot& snapshot) {
          " vehicle(s)  " + stamp + "\n";
 }
 
-// Joins the domain; on failure writes the reason and returns the exit code.
-std::optional<int> open_monitor(std::optional<FleetMonitor>& monitor, const FleetMonitorOptions& options,
-                                std::ostream& err) {
-  try {
-    monitor.emplace(options);
-  } catch (const std::invalid_argument& e) {
-    err << "pullout: " << e.what() << '\n';
-    return kExitBadInput;
-  } catch (const FleetMonitorError& e) {
-    err << "pullout: DDS setup failed: " << e.what() << '\n';
-    return kExitCommunication;
-  }
-  return std::nullopt;
-}
-
 }  // namespace
 
 int run_watch(const WatchOptions& options, bool terminal, std::ostream& out, std::ostream& err) {
@@ -70,7 +56,7 @@ int run_watch(const WatchOptions& options, bool terminal, std::ostream& out, std
   FleetMonitorOptions monitor_options;
   monitor_options.domain_id = options.domain_id;
   monitor_options.profiles_file = options.profiles_file;
-  if (const auto failed = open_monitor(monitor, monitor_options, err)) return *failed;
+  if (const auto failed = open_endpoint<FleetMonitorError>(monitor, monitor_options, err)) return *failed;
 
   const auto start = SteadyClock::now();
   if (options.once) {
@@ -166,7 +152,7 @@ int run_view(const ViewOptions& options, std::ostream& out, std::ostream& err) {
 
   std::optional<FleetMonitor> monitor;
   std::optional<ViewServer> server;
-  if (const auto failed = open_monitor(monitor, monitor_options, err)) return *failed;
+  if (const auto failed = open_endpoint<FleetMonitorError>(monitor, monitor_options, err)) return *failed;
   try {
     server.emplace(*monitor, server_options);
   } catch (const std::runtime_error& e) {

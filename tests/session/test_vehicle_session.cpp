@@ -8,8 +8,10 @@
 #include <memory>
 #include <string>
 
+#include "pullout/config/config.hpp"
 #include "pullout/config/scenario.hpp"
 #include "pullout/pipeline/start_planner.hpp"
+#include "pullout/safety/safety_monitor.hpp"
 #include "pullout/search/stop_condition.hpp"
 #include "pullout/session/vehicle_session.hpp"
 #include "test_world.hpp"
@@ -684,6 +686,50 @@ TEST_F(RestoredSession, WithTheWorldOfALaterRequestTheVehicleKeepsItsSegmentUnde
   const SessionEffects refused = restore_into_new(snap);
   ASSERT_TRUE(refused.status);
   EXPECT_EQ(refused.status->state, ExecutionState::kNoPath);
+}
+
+// A bus restored by another process is checked with the bus's footprint, not the configured car's:
+// a car comes from behind at 5 m/s, 33 m back, on the road the bus pulls out onto. The car's RSS
+// distance leaves room for a car's rear (1.1 m behind its rear axle) but not for the bus's (3.5 m).
+TEST_F(RestoredSession, ABusIsCheckedWithItsOwnFootprintNotTheConfiguredCars) {
+  planner_ = std::make_unique<StartPlanner>(VehicleInfo{}, StartPlannerParameters{}, RequestLimits{}, nullptr,
+                                            default_vehicle_profiles());
+  session_ = std::make_unique<VehicleSession>("test", *planner_);
+  PullOutRequest request = test::straight_shoulder_request();
+  // The lanes lengthened backwards, so that the car behind is on the road.
+  request.lanes = {test::straight_lane(1, LaneSubtype::kRoad, -200, 100, -1.75, 1.75),
+                   test::straight_lane(2, LaneSubtype::kRoadShoulder, -200, 100, 1.75, 4.75)};
+  request.vehicle_profile = "bus";
+  Object behind = test::parked_car(21, -33.0, 0.0);
+  behind.velocity_mps = 5.0;
+  request.objects = {behind};
+  const SessionEffects found = plan(request);
+  ASSERT_TRUE(found.path && found.status);
+  ASSERT_TRUE(found.path->found);
+  EXPECT_FALSE(found.status->safe);
+  sc_.request = request;
+  sc_.request.vehicle_id = "test";
+  found_ = *found.path;
+  const Pose2 start = start_of(found_);
+
+  // What makes the difference: the same path and world checked with the configured car's
+  // footprint is safe, with the bus's it is not.
+  std::vector<RequestIssue> issues;
+  const auto world = planner_->planned_world(sc_.request, issues);
+  ASSERT_TRUE(world && issues.empty());
+  ASSERT_EQ(world->vehicle, default_vehicle_profiles().at("bus"));
+  SafetyMonitor as_car(planner_->parameters(), VehicleInfo{}, world->lanes, world->objects, found_);
+  ASSERT_TRUE(as_car.evaluate(start, 0.0, 0, false).safe);
+  SafetyMonitor as_bus(planner_->parameters(), world->vehicle, world->lanes, world->objects, found_);
+  ASSERT_FALSE(as_bus.evaluate(start, 0.0, 0, false).safe);
+
+  const SessionEffects e = restore_into_new(snapshot());
+  ASSERT_TRUE(e.status);
+  EXPECT_EQ(e.status->state, ExecutionState::kWaitingApproval);
+  progress(start, 0.0, true);
+  EXPECT_EQ(status().state, ExecutionState::kWaitingSafety);
+  EXPECT_FALSE(status().departed);
+  EXPECT_NE(status().stop_reason.find("object 21"), std::string::npos) << status().stop_reason;
 }
 
 TEST_F(RestoredSession, AWaitingVehicleStillNeedsItsApproval) {
