@@ -357,6 +357,67 @@ TEST(FreespacePullOut, GridOnlyRequestsNeedTheFreespacePlanner) {
   EXPECT_EQ(r.issues[0].field, "lanes");
 }
 
+// The freespace fallback from a backward start candidate (start_planner.hpp): the end poses of the
+// current pose lie in road works, those of a candidate behind it do not.
+TEST(FreespacePullOut, FallbackPlansFromABackwardStartCandidateWhenTheCurrentPoseFails) {
+  const Scenario sc = load("freespace_blocked_ahead");
+  {
+    // The lane planner alone finds nothing; nor does freespace from the current pose alone.
+    Scenario alone = sc;
+    alone.parameters.freespace_planner.enable_freespace_planner = false;
+    EXPECT_EQ(StartPlanner(alone.vehicle, alone.parameters).plan(alone.request, StopCondition()).outcome,
+              PlanningResult::Outcome::kNoPath);
+    alone = sc;
+    alone.parameters.enable_back = false;
+    const PlanningResult r = StartPlanner(alone.vehicle, alone.parameters).plan(alone.request, StopCondition());
+    EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+    ASSERT_FALSE(r.evaluation_table.empty());
+    EXPECT_EQ(r.evaluation_table.back().planner, PlannerType::kFreespace);
+    EXPECT_EQ(r.evaluation_table.back().outcome, AttemptOutcome::kGoalInvalid) << describe(r.evaluation_table.back());
+  }
+  expect_drivable_freespace_path(sc);
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition::after_ms(5000));
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  // Rows: freespace from the current pose failed (its end poses in the works), then succeeded
+  // from a candidate behind.
+  std::vector<const PlannerAttempt*> rows;
+  for (const auto& a : r.evaluation_table) {
+    if (a.planner == PlannerType::kFreespace) rows.push_back(&a);
+  }
+  ASSERT_GE(rows.size(), 2u);
+  EXPECT_EQ(rows.front()->backward_distance_m, 0.0);
+  EXPECT_EQ(rows.front()->outcome, AttemptOutcome::kGoalInvalid) << describe(*rows.front());
+  EXPECT_EQ(rows.back()->outcome, AttemptOutcome::kSuccess);
+  const double back = rows.back()->backward_distance_m;
+  EXPECT_GT(back, 0.0);
+  // The path: a straight reverse of that length from the current pose along the shoulder,
+  // stopped at its end, then the freespace path; its end pose within the candidate's reach.
+  const PathWithLaneId& reverse = r.path.partial_paths.front();
+  ASSERT_GE(r.path.partial_paths.size(), 2u);
+  for (std::size_t i = 0; i + 1 < reverse.points.size(); ++i)
+    EXPECT_LT(reverse.points[i].longitudinal_velocity_mps, 0.0);
+  EXPECT_EQ(reverse.points.back().longitudinal_velocity_mps, 0.0);
+  for (const auto& p : reverse.points) EXPECT_NEAR(p.pose.y, sc.request.ego_pose.y, 1e-6);
+  EXPECT_NEAR(reverse.points.back().pose.x, sc.request.ego_pose.x - back, 1e-6);
+  EXPECT_NEAR(r.path.start_pose.x, sc.request.ego_pose.x - back, 1e-6);
+  const FreespaceParameters& fp = sc.parameters.freespace_planner;
+  EXPECT_LE(r.path.end_pose.x, sc.request.ego_pose.x - back + fp.end_pose_search_end_distance + 1e-6);
+  EXPECT_LT(r.path.end_pose.x + sc.vehicle.length_m() - sc.vehicle.base_to_rear_m(), 60.0) << "short of the works";
+}
+
+// Listed in search_priority, freespace runs per start candidate in the search's order: from the
+// candidate behind too (it answered "current pose only" before).
+TEST(FreespacePullOut, ListedFreespacePlansFromABackwardStartCandidate) {
+  Scenario sc = load("freespace_blocked_ahead");
+  sc.parameters.search_priority = {PlannerType::kFreespace};
+  sc.parameters.collision_check_margins = {0.1};
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition::after_ms(5000));
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  EXPECT_EQ(r.path.planner_type, PlannerType::kFreespace);
+  EXPECT_GT(r.evaluation_table.back().backward_distance_m, 0.0);
+  EXPECT_LT(r.path.partial_paths.front().points.front().longitudinal_velocity_mps, 0.0);
+}
+
 TEST(FreespacePullOut, FreespaceInSearchPriorityRunsInItsPlace) {
   Scenario sc = load("freespace_boxed_in");
   sc.parameters.search_priority = {PlannerType::kFreespace};

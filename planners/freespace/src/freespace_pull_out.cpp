@@ -15,7 +15,6 @@ namespace pullout {
 namespace {
 
 constexpr double kTrimDistance = 1.0;  // [m] Autoware's trim around the end pose
-constexpr double kSamePose = 1e-6;     // [m]
 constexpr double kWindowExtra = 10.0;  // [m] costmap window beyond the farthest end pose
 constexpr int kRoomBisections = 12;    // a shape margin of up to a few metres to about 1 mm
 constexpr double kRoomSlack = 0.01;    // [m] left between the start and what its margin reaches
@@ -257,10 +256,6 @@ FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const Vehicle
 PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2& start,
                                          const StopCondition& stop) const {
   PlannerCandidates out;
-  if (std::hypot(start.x - ctx.ego.x, start.y - ctx.ego.y) > kSamePose) {
-    out.failure = Failure{AttemptOutcome::kStartInvalid, "freespace plans from the current pose only"};
-    return out;
-  }
   const FreespaceParameters& p = parameters_;
   // One budget (time_limit) for every end pose; the caller's deadline and cancellation stay in.
   const StopCondition until = stop.with_budget_ms(p.time_limit);
@@ -286,12 +281,14 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
   const HybridAStarConfig search_config = freespace_search_config(ctx.vehicle, p);
   const FreespaceSearch search = freespace_search(p, rrt_star_);
 
+  // The end poses lie ahead of the start (the current pose or a start candidate behind it), as
+  // the lane planners' do.
   const Polyline& center = ctx.road.centerline;
-  const double s_ego = center.project(to_vec(ctx.ego)).s;
+  const double s_start = center.project(to_vec(start)).s;
   Failure last_failure{AttemptOutcome::kGoalInvalid, "no end pose on the road ahead"};
   for (double d = p.end_pose_search_start_distance; d <= p.end_pose_search_end_distance + 1e-9;
        d += p.end_pose_search_interval) {
-    const double s_end = s_ego + d;
+    const double s_end = s_start + d;
     if (s_end > center.length()) break;
     out.stopped = until.check();
     if (out.stopped != StopReason::kNone) break;
@@ -316,9 +313,9 @@ PlannerCandidates FreespacePullOut::plan(const PlanningContext& ctx, const Pose2
     candidate.nearest_obstacle = clearance.obstacle_id;
     const PlanningContext* c = &ctx;
     candidate.build = [c, fp = p, waypoints = std::move(r.waypoints), exact = r.reached_exact_goal, end_pose, s_end,
-                       s_ego]() {
+                       s_start]() {
       SplitPath split = split_at_cusps(waypoints, fp.velocity);
-      const std::int64_t fallback_id = road_lane_id_at(*c, s_ego);
+      const std::int64_t fallback_id = road_lane_id_at(*c, s_start);
       PathWithLaneId& last = split.partial_paths.back();
       // Road points follow from one interval after tail_from.
       double tail_from = s_end;

@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "pullout/collision/footprint.hpp"
@@ -547,6 +548,23 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     }
   }
 
+  // Freespace's one time_limit over every start it is tried from, counted from its first attempt.
+  std::optional<StopCondition> freespace_until;
+  const auto freespace_stop = [&]() -> const StopCondition& {
+    if (!freespace_until) freespace_until = stop.with_budget_ms(params.freespace_planner.time_limit);
+    return *freespace_until;
+  };
+  // Reverse to the start candidate first. Pair: cruise at backward_velocity, reached over half
+  // the segment (a = v^2 / L) so that the vehicle stops at its end.
+  const auto prepend_reverse = [&](const StartCandidate& start) {
+    if (start.backward_distance <= 0.0) return;
+    const double v = params.backward_velocity;
+    result.path.partial_paths.insert(result.path.partial_paths.begin(),
+                                     reverse_segment(context, params, request.ego_pose, start));
+    result.path.pairs_terminal_velocity_and_accel.insert(result.path.pairs_terminal_velocity_and_accel.begin(),
+                                                         {v, -v * v / start.backward_distance});
+  };
+
   const auto accept = [&](const PathCandidate& chosen, PlannerType type) {
     result.outcome = PlanningResult::Outcome::kFound;
     result.path = chosen.build();
@@ -567,7 +585,10 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
       if (result.stopped != StopReason::kNone) break;
       const StartCandidate& start = starts[ci];
       auto& slot = planned[ci * planners.size() + pi];
-      if (!slot) slot = planners[pi]->plan(context, start.pose, stop);
+      if (!slot) {
+        const bool freespace = planners[pi]->type() == PlannerType::kFreespace;
+        slot = planners[pi]->plan(context, start.pose, freespace ? freespace_stop() : stop);
+      }
       // The caller's limits end the whole search; a planner's own budget only its attempt.
       if (slot->stopped == StopReason::kDeadline || slot->stopped == StopReason::kCancelled) {
         result.stopped = slot->stopped;
@@ -577,15 +598,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
           {planners[pi]->type(), margin, start.backward_distance, sel.outcome, sel.detail});
       if (sel.chosen != nullptr) {
         accept(*sel.chosen, planners[pi]->type());
-        if (start.backward_distance > 0.0) {
-          // Reverse to the start candidate first. Pair: cruise at backward_velocity, reached
-          // over half the segment (a = v^2 / L) so that the vehicle stops at its end.
-          const double v = params.backward_velocity;
-          result.path.partial_paths.insert(result.path.partial_paths.begin(),
-                                           reverse_segment(context, params, request.ego_pose, start));
-          result.path.pairs_terminal_velocity_and_accel.insert(result.path.pairs_terminal_velocity_and_accel.begin(),
-                                                               {v, -v * v / start.backward_distance});
-        }
+        prepend_reverse(start);
         publish_checked(result, checker, margin, params);
         finish(result);
         return result;
@@ -624,21 +637,29 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   // Nothing found: the freespace fallback (unless it was searched in the order already).
   const bool freespace_listed = std::find(params.search_priority.begin(), params.search_priority.end(),
                                           PlannerType::kFreespace) != params.search_priority.end();
+  // The current pose first (candidate 0), then the start candidates behind it, nearest first, all
+  // within one time_limit: a candidate adds what the current pose cannot reach, end poses ahead of
+  // it (those of the current pose blocked) or a start the costmap finds free.
   if (params.freespace_planner.enable_freespace_planner && !freespace_listed && result.stopped == StopReason::kNone) {
-    const PlannerCandidates fallback =
-        FreespacePullOut(params.freespace_planner, &plan_rrt_star).plan(context, request.ego_pose, stop);
-    if (fallback.stopped == StopReason::kDeadline || fallback.stopped == StopReason::kCancelled) {
-      result.stopped = fallback.stopped;
-    }
-    // The costmap keeps the grown footprint off every object: the margin is half the growth.
-    const double margin = 0.5 * params.freespace_planner.vehicle_shape_margin;
-    const Selection sel = select_candidate(fallback, 1e-6);  // any clearance: no contact
-    result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, sel.outcome, sel.detail});
-    if (sel.chosen != nullptr) {
-      accept(*sel.chosen, PlannerType::kFreespace);
-      publish_checked(result, checker, margin, params);
-      finish(result);
-      return result;
+    const FreespacePullOut freespace(params.freespace_planner, &plan_rrt_star);
+    for (const StartCandidate& start : starts) {
+      const PlannerCandidates fallback = freespace.plan(context, start.pose, freespace_stop());
+      if (fallback.stopped == StopReason::kDeadline || fallback.stopped == StopReason::kCancelled) {
+        result.stopped = fallback.stopped;
+      }
+      // The costmap keeps the grown footprint off every object: the margin is half the growth.
+      const double margin = 0.5 * params.freespace_planner.vehicle_shape_margin;
+      const Selection sel = select_candidate(fallback, 1e-6);  // any clearance: no contact
+      result.evaluation_table.push_back(
+          {PlannerType::kFreespace, margin, start.backward_distance, sel.outcome, sel.detail});
+      if (sel.chosen != nullptr) {
+        accept(*sel.chosen, PlannerType::kFreespace);
+        prepend_reverse(start);
+        publish_checked(result, checker, margin, params);
+        finish(result);
+        return result;
+      }
+      if (fallback.stopped != StopReason::kNone) break;  // the budget too: it is spent
     }
   }
 

@@ -13,9 +13,11 @@
 //    Autoware's default margin (1.0 m, meant for open lots) otherwise puts the start of a car
 //    parked at a kerb in collision; the search keeps the clamped margin everywhere. Steering
 //    limited to max_steer_angle x max_turning_ratio;
-//  - end poses: on the road centerline from s(ego) + end_pose_search_start_distance to
-//    s(ego) + end_pose_search_end_distance every end_pose_search_interval; the first one reached
-//    wins;
+//  - end poses: on the road centerline from s(start) + end_pose_search_start_distance to
+//    s(start) + end_pose_search_end_distance every end_pose_search_interval; the first one reached
+//    wins. The start is the current pose, or (unlike Autoware, whose freespace pull-out plans
+//    from the current pose only) a backward start candidate when the current pose fails: see
+//    StartPlanner::plan (start_planner.hpp);
 //  - output: the path split at every change of direction (the cusp point ends one partial path
 //    and starts the next), +/- velocity on the points and 0 at every cusp; the last forward
 //    partial path trimmed within 1 m of the end pose when the search stopped in the goal region
@@ -45,8 +47,9 @@ class FreespacePullOut : public PullOutPlanner {
   // plan_rrt_star); std::invalid_argument when that algorithm is asked for without it.
   explicit FreespacePullOut(const FreespaceParameters& parameters, FreespaceSearch rrt_star = {});
   PlannerType type() const override { return PlannerType::kFreespace; }
-  // One candidate at most. Plans from the current pose only (context.ego): a backward start
-  // candidate gets a failure, the search itself reverses where needed.
+  // One candidate at most, from `start`: the current pose (context.ego) or a backward start
+  // candidate (the pipeline puts the straight reverse to it in front of the path). The end poses
+  // are measured from s(start); the costmap's window stays centred on the current pose.
   PlannerCandidates plan(const PlanningContext& context, const Pose2& start, const StopCondition& stop) const override;
 
  private:

@@ -7,8 +7,13 @@
 //   planner's multi-move manoeuvre from the ego pose at the smallest margin (the geometric
 //   planner's shunting, geometric_pull_out_max_shunts > 0; evaluation-table detail "shunting").
 //   Still nothing and freespace_planner.enable_freespace_planner: the freespace pull-out (hybrid
-//   A*) from the ego pose. A request with an occupancy grid and no lanes (allowed when the freespace planner is
-//   enabled) is a pure freespace problem: hybrid A* straight to the goal pose.
+//   A*) from the ego pose and, when that finds nothing (and enable_back), from the backward start
+//   candidates in order of their distance (a straight reverse to the candidate, a stop, then the
+//   freespace path; its end poses ahead of the candidate): one freespace_planner.time_limit for
+//   all of them, the current pose first, so that what succeeds from it today is unchanged. The
+//   same when freespace is listed in search_priority (one budget over its candidates). A request
+//   with an occupancy grid and no lanes (allowed when the freespace planner is enabled) is a pure
+//   freespace problem: hybrid A* straight to the goal pose.
 //
 // Thread safety: StartPlanner is immutable after construction; plan() may be called concurrently
 // from several threads. Failure modes are values, never exceptions: an invalid request gives
