@@ -194,7 +194,7 @@ TEST(PublishedPath, ScenariosThatStopBeforeAnObjectDo) {
       EXPECT_TRUE(overlap(vehicle_box(sc.vehicle, last.pose, margin + 0.1), object_shape(o))) << name;
     }
   }
-  EXPECT_EQ(with_key, 2u);
+  EXPECT_EQ(with_key, 3u);  // car_parked_beyond_end, centerline_car_ahead, freespace_blocked_ahead
 }
 
 // ---- the unit on hand-made paths ----
