@@ -30,10 +30,10 @@ struct Box {
 constexpr double kSlotStart = 8.0;
 constexpr double kSlotEnd = 13.19;
 const std::vector<Box> kStreet{
-    {0.0, 0.0, 30.0, 1.0},                     // kerb
-    {0.0, 13.6, 30.0, 14.0},                   // wall across the street
-    {2.9, 1.2, kSlotStart, 3.1},               // car behind the slot
-    {kSlotEnd, 1.2, kSlotEnd + 5.1, 3.1},      // car ahead of it
+    {0.0, 0.0, 30.0, 1.0},                 // kerb
+    {0.0, 13.6, 30.0, 14.0},               // wall across the street
+    {2.9, 1.2, kSlotStart, 3.1},           // car behind the slot
+    {kSlotEnd, 1.2, kSlotEnd + 5.1, 3.1},  // car ahead of it
 };
 // In the slot, 0.25 m from either car, 0.2 m from the kerb.
 const Pose2 kInSlot{kSlotStart + 0.25 + 0.929, 1.0 + 0.2 + 0.971, 0.0};

@@ -445,8 +445,9 @@ HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const
     result.status = HybridAStarResult::Status::kGoalOccupied;
     return result;
   }
-  // The plain search from the start first. When it is stuck (its open list empties, or its
-  // obstacle-aware distance to the goal has not fallen over stall_expansions expansions), the
+  // The plain search from the start first. When it is stuck (its open list empties, or it has
+  // come within kNearGoalCells lattice cells of the goal and not got closer by kProgress over
+  // stall_expansions expansions: far from the goal a long plateau is normal), the
   // rescue searches join it, taking turns: from the goal (search_from_goal) when the goal lies in
   // a tight spot (its first expansion finds it constrained), and, once the plain search's open
   // list is empty, from the start again; both with the fine moves at constrained nodes
@@ -468,7 +469,7 @@ HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const
   Slot& fine_start = slots[2];
   plain.search = std::make_unique<Search>(checker_, config_, start, goal, false, false);
   plain.search->begin(stop, start_clearance);
-  goal_side.done = !from_goal;
+  goal_side.done = !from_goal || !fine;  // min_primitive_length 0: the plain search alone
   fine_start.done = !fine;
   Search::State state = Search::State::kRunning;
   Search* found = nullptr;
