@@ -6,7 +6,11 @@
 //                               [--ours-only] [--no-peers]
 //
 //   build/bench/bench_freespace --tpcap ../shared/benchmarks/tpcap [--resolution 0.1] [--budget-ms 10000]
-//                               [--case N] [--min-primitive M] [--search-from-goal]
+//                               [--case N] [--min-primitive M] [--search-from-goal] [--stall-expansions N]
+//
+// --min-primitive, --search-from-goal and --stall-expansions set the rescue of a stuck search
+// (HybridAStarConfig: min_primitive_length, default 0.1, 0 = the plain search alone;
+// search_from_goal, default on; stall_expansions, default 1000).
 //
 // --tpcap runs the 20 TPCAP cases (bench/tpcap.hpp; read at run time, never committed) instead of
 // the generated lots: the organisers' vehicle (no shape margin), turning radius from wheelbase
@@ -193,6 +197,7 @@ struct SearchOverrides {
   int turning_steps{0};
   double min_primitive{-1.0};  // < 0: the default
   bool from_goal{false};
+  long stall_expansions{-1};  // < 0: the default
 } g_search;
 
 struct Run {
@@ -221,6 +226,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   if (g_search.narrow_penalty >= 0.0) config.narrow_heuristic_penalty = g_search.narrow_penalty;
   if (g_search.min_primitive >= 0.0) config.min_primitive_length = g_search.min_primitive;
   if (g_search.from_goal) config.search_from_goal = true;
+  if (g_search.stall_expansions >= 0) config.stall_expansions = static_cast<std::size_t>(g_search.stall_expansions);
   std::vector<Pose2> expanded;
   const char* dump = std::getenv("PULLOUT_DUMP_EXPANSIONS");  // directory: <problem index>.pgm / .txt
   if (dump != nullptr) config.expanded_poses = &expanded;
@@ -459,6 +465,8 @@ int main(int argc, char** argv) {
       g_search.from_goal = true;
     } else if (has_value && std::strcmp(argv[i], "--min-primitive") == 0) {
       g_search.min_primitive = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--stall-expansions") == 0) {
+      g_search.stall_expansions = std::atol(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--case") == 0) {
       only_case = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--resolution") == 0) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <queue>
 
@@ -24,6 +25,9 @@ constexpr double kCoarseSpacing = 1.0;            // [m] first-pass sample spaci
 constexpr std::uint64_t kFineKey = 1ULL << 62;    // lattice keys of fine cells
 // A node with fewer full-length primitives to new cells than this is constrained (see expand).
 constexpr int kOpenPrimitives = 3;
+// The plain search counts as stuck near the goal (see plan) within this many lattice cells of it.
+constexpr double kNearGoalCells = 2.0;
+constexpr double kProgress = 0.25;  // [m] a fall of the distance to the target that counts as progress
 
 struct Node {
   Pose2 pose;
@@ -52,14 +56,17 @@ class Search {
  public:
   enum class State { kRunning, kFound, kExhausted, kNodeLimit, kStopped };
 
+  // `fine_moves`: constrained nodes also drive until contact and give their children fine cells
+  // (needs config.min_primitive_length > 0); else the plain search.
   Search(const GridCollisionChecker& checker, const HybridAStarConfig& config, const Pose2& root, const Pose2& target,
-         bool backward)
+         bool backward, bool fine_moves)
       : checker_(checker),
         costmap_(checker.costmap()),
         config_(config),
         root_(root),
         target_(target),
         backward_(backward),
+        fine_moves_(fine_moves && config.min_primitive_length > 0.0),
         rs_(config.turning_radius),
         weights_{config.curve_weight, config.reverse_weight, config.direction_change_weight},
         heuristic_(costmap_, heuristic_config(checker, config), target, root) {}
@@ -91,6 +98,10 @@ class Search {
       }
       // Analytic expansion: every expansion near the target, less often far from it.
       const double h2d = heuristic_.distance(node.pose);
+      if (h2d < best_h2d_ - kProgress) {
+        best_h2d_ = h2d;
+        last_progress_ = expansions_;
+      }
       const auto interval = static_cast<std::size_t>(std::max(1.0, h2d / kShotDistancePerInterval));
       if (++since_shot_ >= interval) {
         since_shot_ = 0;
@@ -112,6 +123,10 @@ class Search {
   // cell): known after the first step.
   bool root_constrained() const { return root_constrained_; }
   std::size_t expansions() const { return expansions_; }
+  // Expansions since the obstacle-aware distance to the target last fell by kProgress.
+  std::size_t since_progress() const { return expansions_ - last_progress_; }
+  // The least obstacle-aware distance to the target of the poses expanded so far [m].
+  double best_distance() const { return best_h2d_; }
   std::size_t nodes() const { return nodes_.size(); }
   std::size_t shots() const { return shots_; }
   StopReason heuristic_stopped() const { return heuristic_.stopped(); }
@@ -236,9 +251,9 @@ class Search {
         moves[free_count++] = {direction, steer, distance, pose, clearance};
       }
     }
-    const bool constrained = config_.min_primitive_length > 0.0 && open < kOpenPrimitives;
+    const bool constrained = open < kOpenPrimitives;
     if (parent.parent < 0) root_constrained_ = constrained;
-    if (constrained && config_.min_primitive_length > 0.0) {
+    if (constrained && fine_moves_) {
       for (std::size_t i = 0; i < refused_count; ++i) {
         Move m = refused[i];
         const fd::Arc arc(parent.pose, c, s, curvature(m.steer));
@@ -253,7 +268,7 @@ class Search {
     const std::uint64_t parent_key = key(parent.pose, parent.fine);
     for (std::size_t i = 0; i < free_count; ++i) {
       const Move& m = moves[i];
-      if (key(m.pose, constrained) == parent_key) continue;
+      if (key(m.pose, constrained && fine_moves_) == parent_key) continue;
       const double driven = std::abs(m.distance);
       double cost = driven * (1.0 + config_.curve_weight * std::abs(m.steer) / steps);
       if ((m.direction < 0) != backward_) cost *= 1.0 + config_.reverse_weight;  // the vehicle reverses
@@ -266,7 +281,7 @@ class Search {
       child.length = driven;
       child.steer = static_cast<std::int8_t>(m.steer);
       child.direction = static_cast<std::int8_t>(m.direction);
-      child.fine = constrained;
+      child.fine = constrained && fine_moves_;
       add_node(child);
     }
   }
@@ -367,6 +382,7 @@ class Search {
   Pose2 root_;
   Pose2 target_;
   bool backward_{false};
+  bool fine_moves_{false};
   ReedsShepp rs_;
   ReedsSheppWeights weights_;
   mutable fd::ObstacleHeuristic heuristic_;  // computed lazily, as the search asks
@@ -376,6 +392,8 @@ class Search {
   std::size_t since_shot_{0};
   std::size_t expansions_{0};
   std::size_t shots_{0};
+  double best_h2d_{std::numeric_limits<double>::infinity()};
+  std::size_t last_progress_{0};
   bool root_constrained_{false};
   using OpenItem = std::pair<double, std::int32_t>;
   std::priority_queue<OpenItem, std::vector<OpenItem>, std::greater<OpenItem>> open_;
@@ -427,26 +445,61 @@ HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const
     result.status = HybridAStarResult::Status::kGoalOccupied;
     return result;
   }
-  // The search from the start, and, when the goal lies in a tight spot (its first expansion finds
-  // it constrained), the search from the goal too, taking turns: getting out of a tight spot is
-  // found where a search begins, where every short move is tried; getting into one from far away
-  // means hitting a small target (bench/RESULTS.md: TPCAP case 7, parallel parking).
-  Search forward(checker_, config_, start, goal, false);
-  std::unique_ptr<Search> backward;
-  forward.begin(stop, start_clearance);
-  if (config_.use_back && config_.search_from_goal) {
-    backward = std::make_unique<Search>(checker_, config_, goal, start, true);
-    backward->begin(stop, goal_clearance);
-  }
+  // The plain search from the start first. When it is stuck (its open list empties, or it has
+  // come within kNearGoalCells lattice cells of the goal and not got closer by kProgress over
+  // stall_expansions expansions: far from the goal a long plateau is normal), the
+  // rescue searches join it, taking turns: from the goal (search_from_goal) when the goal lies in
+  // a tight spot (its first expansion finds it constrained), and, once the plain search's open
+  // list is empty, from the start again; both with the fine moves at constrained nodes
+  // (min_primitive_length). Getting out of a tight spot is found where a search begins, where
+  // every short move is tried; getting into one from far away means hitting a small target
+  // (bench/RESULTS.md: TPCAP case 7, parallel parking; case 20, a maze whose start pocket needs
+  // short moves). The plain search pays nothing for them where it is not stuck.
+  const bool fine = config_.min_primitive_length > 0.0;
+  const bool from_goal = config_.use_back && config_.search_from_goal;
+  const double near_goal =
+      kNearGoalCells * (config_.xy_resolution > 0.0 ? config_.xy_resolution : config_.primitive_length);
+  struct Slot {
+    std::unique_ptr<Search> search;
+    bool done{false};
+  };
+  std::array<Slot, 3> slots;  // plain from the start, from the goal, fine from the start
+  Slot& plain = slots[0];
+  Slot& goal_side = slots[1];
+  Slot& fine_start = slots[2];
+  plain.search = std::make_unique<Search>(checker_, config_, start, goal, false, false);
+  plain.search->begin(stop, start_clearance);
+  goal_side.done = !from_goal || !fine;  // min_primitive_length 0: the plain search alone
+  fine_start.done = !fine;
   Search::State state = Search::State::kRunning;
   Search* found = nullptr;
-  bool forward_done = false;
-  bool backward_done = backward == nullptr;
   bool node_limit = false;
-  for (std::size_t turn = 0; !forward_done || !backward_done; ++turn) {
+  std::size_t next = 0;
+  for (std::size_t turn = 0;; ++turn) {
     if (turn % kStopCheckInterval == 0 && (result.stopped = stop.check()) != StopReason::kNone) break;
-    const bool backward_turn = !backward_done && (forward_done || turn % 2 == 1);
-    Search& search = backward_turn ? *backward : forward;
+    // The rescue searches, once the plain one is stuck.
+    const bool exhausted = plain.done;
+    const bool stuck = exhausted || (plain.search->best_distance() <= near_goal &&
+                                     plain.search->since_progress() >= config_.stall_expansions);
+    if (stuck && !goal_side.done && goal_side.search == nullptr) {
+      goal_side.search = std::make_unique<Search>(checker_, config_, goal, start, true, true);
+      goal_side.search->begin(stop, goal_clearance);
+    }
+    if (exhausted && !fine_start.done && fine_start.search == nullptr) {
+      fine_start.search = std::make_unique<Search>(checker_, config_, start, goal, false, true);
+      fine_start.search->begin(stop, start_clearance);
+    }
+    // The next running search, in turn.
+    Slot* slot = nullptr;
+    for (std::size_t k = 0; k < slots.size() && slot == nullptr; ++k) {
+      Slot& s = slots[(next + k) % slots.size()];
+      if (s.search != nullptr && !s.done) {
+        slot = &s;
+        next = (next + k + 1) % slots.size();
+      }
+    }
+    if (slot == nullptr) break;  // every search ended without a path
+    Search& search = *slot->search;
     state = search.step();
     if (state == Search::State::kFound) {
       found = &search;
@@ -458,16 +511,17 @@ HybridAStarResult HybridAStar::plan(const Pose2& start, const Pose2& goal, const
     }
     if (state != Search::State::kRunning) {
       node_limit = node_limit || state == Search::State::kNodeLimit;
-      (backward_turn ? backward_done : forward_done) = true;
+      slot->done = true;
     }
-    // The goal is open: the search from the start alone (its root expanded by now).
-    if (backward_turn && backward != nullptr && backward->expansions() == 1 && !backward->root_constrained()) {
-      backward_done = true;
-    }
+    // The goal is open: no search from it (its root expanded by now).
+    if (slot == &goal_side && search.expansions() == 1 && !search.root_constrained()) goal_side.done = true;
   }
-  result.expansions = forward.expansions() + (backward != nullptr ? backward->expansions() : 0);
-  result.nodes = forward.nodes() + (backward != nullptr ? backward->nodes() : 0);
-  result.shots = forward.shots() + (backward != nullptr ? backward->shots() : 0);
+  for (const Slot& s : slots) {
+    if (s.search == nullptr) continue;
+    result.expansions += s.search->expansions();
+    result.nodes += s.search->nodes();
+    result.shots += s.search->shots();
+  }
   if (found == nullptr) {
     result.status = result.stopped == StopReason::kCancelled ? HybridAStarResult::Status::kCancelled
                     : result.stopped != StopReason::kNone    ? HybridAStarResult::Status::kTimeout

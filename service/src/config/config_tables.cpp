@@ -223,6 +223,12 @@ const Table<FreespaceParameters::Astar>& astar_table() {
           field("expansion_distance", &T::expansion_distance, "m", in(0.05, 10.0), "arc length of a motion primitive"),
           field("narrow_heuristic_penalty", &T::narrow_heuristic_penalty, "", in(0.0, 100.0),
                 "(not Autoware) heuristic cost x (1 + this) where too narrow to turn; 0 = off"),
+          field("min_expansion_distance", &T::min_expansion_distance, "m", in(0.0, 10.0),
+                "(not Autoware) stuck search: in tight spots drive until contact, at least this far; 0 = off"),
+          field("search_from_goal", &T::search_from_goal, "", AnyValue{},
+                "(not Autoware) stuck search: also search from a goal in a tight spot"),
+          field("stall_expansions", &T::stall_expansions, "", in(0, 10000000),
+                "(not Autoware) expansions without progress near the goal before the stuck-search rescue"),
       },
       &freespace_hint};
   return t;

@@ -40,6 +40,14 @@ struct FreespaceParameters {
     // Not in Autoware: the obstacle-aware heuristic charges up to (1 + this) per metre through
     // places narrower than the vehicle needs to turn (see hybrid_astar.hpp); 0 = plain distance.
     double narrow_heuristic_penalty{3.0};
+    // Not in Autoware: the rescue searches of a stuck search (see hybrid_astar.hpp). At nodes in
+    // a tight spot, primitives that collide are driven until contact when that is at least this
+    // long [m] (0 = off, and no rescue searches at all); search_from_goal adds the search from a
+    // goal in a tight spot; stall_expansions is how long the plain search may make no progress
+    // near the goal before they join it.
+    double min_expansion_distance{0.1};
+    bool search_from_goal{true};
+    int stall_expansions{1000};
   } astar;
 };
 

@@ -34,6 +34,20 @@
 // stretch it proves free. So a returned path is collision-free at every point, not only at its
 // samples, and a motion is refused only if it passes within an eighth of a cell of an obstacle.
 //
+// Stuck searches. A car wriggles out of a tight spot (a parallel slot, a maze's pocket) with short
+// moves between cusps, which 0.5 m primitives on a 0.5 m lattice cannot make. The search starts
+// plain; when it is stuck (its open list is empty, or it has come within two lattice cells of the
+// goal and made no progress for stall_expansions expansions), rescue searches join it, taking
+// turns: from the goal, when the goal is in a tight spot and search_from_goal is set (getting out
+// of a tight spot is found where a search begins; getting into one from afar means hitting a small
+// target), and, once the plain search's open list is empty, from the start again. They expand a
+// constrained node (fewer than 3 of its primitives reach a new cell) with its collided primitives
+// too, driven until contact when that is at least min_primitive_length, and give its children a
+// fine lattice cell (fine_xy_resolution, theta_size * fine_theta_factor headings). A search from
+// the goal grows the path backwards in time and ends with a Reeds-Shepp shot to the exact start.
+// Where the plain search is not stuck, it runs alone and the rescue costs nothing
+// (bench/RESULTS.md, TPCAP cases 7 and 20).
+//
 // Failure modes are values (Status), never exceptions. The stop condition is checked before the
 // first expansion and every few expansions after it, and inside the obstacle heuristic's flood of
 // the grid (every 1024 cells); the search returns kTimeout (deadline or budget) or kCancelled
@@ -64,14 +78,18 @@ struct HybridAStarConfig {
   // bins (theta_size times this).
   double fine_xy_resolution{0.02};
   int fine_theta_factor{4};
-  // [m] a primitive that would collide is cut to its free part when that is at least this long
-  // ("drive until contact") at constrained nodes, whose children also get the fine lattice; 0 = off
-  // (the plain search). Off by default: TPCAP 20/20 with 0.02 and search_from_goal, but cases 9
-  // and 19 take seconds (bench/RESULTS.md).
-  double min_primitive_length{0.0};
+  // [m] in the rescue searches (see the note above), a primitive that would collide is cut to its
+  // free part when that is at least this long ("drive until contact") at constrained nodes, whose
+  // children also get the fine lattice; 0 = no rescue searches (the plain search alone).
+  double min_primitive_length{0.1};
   bool use_back{true};  // expand reverse primitives
-  // Also search from the goal when it lies in a tight spot (see the note above); needs use_back.
-  bool search_from_goal{false};
+  // The rescue search from the goal when it lies in a tight spot (see the note above); needs
+  // use_back and min_primitive_length > 0.
+  bool search_from_goal{true};
+  // [expansions] the plain search may go without progress near the goal (its least obstacle-aware
+  // distance to the goal within two lattice cells, not falling by a further 0.25 m) before it
+  // counts as stuck; 0 = stuck from the outset (the rescue searches run from the first turn).
+  std::size_t stall_expansions{1000};
   double curve_weight{0.5};
   double reverse_weight{1.0};
   double direction_change_weight{1.5};    // [m] added per change of driving direction
