@@ -5,10 +5,10 @@
 // rectangle against the true obstacle boxes (separating axes, no costmap), every centimetre.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
 #include <vector>
 
+#include "../planners/path_oracles.hpp"
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/hybrid_astar.hpp"
 #include "pullout/geometry/angle.hpp"
@@ -49,32 +49,11 @@ Costmap street_map() {
   return Costmap::from_polygons(extent, 0.1, {all}, {}, polygons);
 }
 
-// The oracle: the footprint's rectangle at `p` overlaps box `b` (separating axis theorem: the
-// box's two axes and the rectangle's two).
+// The oracle (tests/planners/path_oracles.hpp): the footprint's rectangle at `p` overlaps box `b`,
+// touching not counted (separating axes: the box's two and the rectangle's two).
 bool overlaps(const Pose2& p, const Box& b) {
-  const double c = std::cos(p.yaw);
-  const double s = std::sin(p.yaw);
-  std::array<Vec2, 4> car;
-  const std::array<std::array<double, 2>, 4> local{
-      {{kCar.front, kCar.left}, {-kCar.rear, kCar.left}, {-kCar.rear, -kCar.right}, {kCar.front, -kCar.right}}};
-  for (std::size_t i = 0; i < 4; ++i) {
-    car[i] = {p.x + c * local[i][0] - s * local[i][1], p.y + s * local[i][0] + c * local[i][1]};
-  }
-  const std::array<Vec2, 4> box{Vec2{b.x0, b.y0}, Vec2{b.x1, b.y0}, Vec2{b.x1, b.y1}, Vec2{b.x0, b.y1}};
-  const std::array<Vec2, 4> axes{Vec2{1, 0}, Vec2{0, 1}, Vec2{c, s}, Vec2{-s, c}};
-  for (const Vec2& axis : axes) {
-    double a_lo = 1e300, a_hi = -1e300, b_lo = 1e300, b_hi = -1e300;
-    for (const Vec2& v : car) {
-      a_lo = std::min(a_lo, v.dot(axis));
-      a_hi = std::max(a_hi, v.dot(axis));
-    }
-    for (const Vec2& v : box) {
-      b_lo = std::min(b_lo, v.dot(axis));
-      b_hi = std::max(b_hi, v.dot(axis));
-    }
-    if (a_hi <= b_lo || b_hi <= a_lo) return false;  // separated
-  }
-  return true;
+  const Polygon box{{b.x0, b.y0}, {b.x1, b.y0}, {b.x1, b.y1}, {b.x0, b.y1}};
+  return oracle::separating_gap(oracle::rectangle_at(kCar, p), box) < 0.0;
 }
 
 HybridAStarConfig config() {
@@ -102,15 +81,9 @@ void expect_free_and_drivable(const HybridAStarResult& r, const Pose2& start, co
     const Pose2& q = r.waypoints[i - 1].pose;
     ASSERT_LE(std::hypot(p.x - q.x, p.y - q.y), 0.01 + 1e-9);
     if (i + 1 >= r.waypoints.size() || r.waypoints[i].direction != r.waypoints[i + 1].direction) continue;
-    // Menger curvature within a cusp-free stretch.
-    const Vec2 a{q.x, q.y};
-    const Vec2 m{p.x, p.y};
+    // Menger curvature within a cusp-free stretch (0 for coincident points).
     const Vec2 e{r.waypoints[i + 1].pose.x, r.waypoints[i + 1].pose.y};
-    const double cross = (m - a).x() * (e - a).y() - (m - a).y() * (e - a).x();
-    const double denom = (m - a).norm() * (e - m).norm() * (e - a).norm();
-    if (denom > 1e-12) {
-      EXPECT_LE(std::abs(2.0 * cross / denom), 1.0 / kRadius * 1.01) << i;
-    }
+    EXPECT_LE(std::abs(oracle::menger_curvature({q.x, q.y}, {p.x, p.y}, e)), 1.0 / kRadius * 1.01) << i;
   }
 }
 

@@ -133,6 +133,11 @@ std::vector<Spot> family() {
   return spots;
 }
 
+// The failure message of a spot that was not left: the search's summary and the first reason.
+std::string why_no_path(const PlanningResult& r) {
+  return "no path: " + r.stop_reason + (r.path.reasons.empty() ? "" : " / " + r.path.reasons.front());
+}
+
 TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   const VehicleInfo v;
   const StartPlannerParameters p = shipped_without_freespace();
@@ -155,8 +160,7 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
     if (s.slack >= 1.0 && s.road_lanes == 2 && s.kerb >= 0.3) {
       ++expected;
       found_expected += found ? 1 : 0;
-      EXPECT_TRUE(found) << s << ": no path: " << r.stop_reason
-                         << (r.path.reasons.empty() ? "" : " / " + r.path.reasons.front());
+      EXPECT_TRUE(found) << s << ": " << why_no_path(r);
     } else {
       ++unclaimed;
       found_unclaimed += found ? 1 : 0;
@@ -218,8 +222,7 @@ TEST(GeometricShunts, LeavesSpotsOnBendsWithAMetreOfSlack) {
           const Street st = make_spot(s, v);
           const PlanningResult r = planner.plan(st.request, StopCondition());
           ++spots;
-          ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound)
-              << s << ": no path: " << r.stop_reason << (r.path.reasons.empty() ? "" : " / " + r.path.reasons.front());
+          ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
           const std::string verdict = check_path(r.path, st, v, margin, radius);
           EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
         }
