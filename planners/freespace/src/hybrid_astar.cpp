@@ -253,7 +253,9 @@ class Search {
     }
     const bool constrained = open < kOpenPrimitives;
     if (parent.parent < 0) root_constrained_ = constrained;
-    if (constrained && fine_moves_) {
+    // Fine moves (drive until contact, fine lattice cells) at constrained nodes of a rescue search.
+    const bool fine = constrained && fine_moves_;
+    if (fine) {
       for (std::size_t i = 0; i < refused_count; ++i) {
         Move m = refused[i];
         const fd::Arc arc(parent.pose, c, s, curvature(m.steer));
@@ -268,7 +270,7 @@ class Search {
     const std::uint64_t parent_key = key(parent.pose, parent.fine);
     for (std::size_t i = 0; i < free_count; ++i) {
       const Move& m = moves[i];
-      if (key(m.pose, constrained && fine_moves_) == parent_key) continue;
+      if (key(m.pose, fine) == parent_key) continue;
       const double driven = std::abs(m.distance);
       double cost = driven * (1.0 + config_.curve_weight * std::abs(m.steer) / steps);
       if ((m.direction < 0) != backward_) cost *= 1.0 + config_.reverse_weight;  // the vehicle reverses
@@ -281,7 +283,7 @@ class Search {
       child.length = driven;
       child.steer = static_cast<std::int8_t>(m.steer);
       child.direction = static_cast<std::int8_t>(m.direction);
-      child.fine = constrained && fine_moves_;
+      child.fine = fine;
       add_node(child);
     }
   }

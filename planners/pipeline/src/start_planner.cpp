@@ -554,18 +554,9 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     if (!freespace_until) freespace_until = stop.with_budget_ms(params.freespace_planner.time_limit);
     return *freespace_until;
   };
-  // Reverse to the start candidate first. Pair: cruise at backward_velocity, reached over half
-  // the segment (a = v^2 / L) so that the vehicle stops at its end.
-  const auto prepend_reverse = [&](const StartCandidate& start) {
-    if (start.backward_distance <= 0.0) return;
-    const double v = params.backward_velocity;
-    result.path.partial_paths.insert(result.path.partial_paths.begin(),
-                                     reverse_segment(context, params, request.ego_pose, start));
-    result.path.pairs_terminal_velocity_and_accel.insert(result.path.pairs_terminal_velocity_and_accel.begin(),
-                                                         {v, -v * v / start.backward_distance});
-  };
-
-  const auto accept = [&](const PathCandidate& chosen, PlannerType type) {
+  // The chosen candidate as the result, planned from `start` at `margin`: the straight reverse to
+  // a start candidate behind the vehicle first, then checked and finished.
+  const auto accept = [&](const PathCandidate& chosen, PlannerType type, const StartCandidate& start, double margin) {
     result.outcome = PlanningResult::Outcome::kFound;
     result.path = chosen.build();
     result.path.found = true;
@@ -574,6 +565,17 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     result.path.turn_signal = result.path.shift_length_m > 0.0   ? TurnSignal::kRight
                               : result.path.shift_length_m < 0.0 ? TurnSignal::kLeft
                                                                  : TurnSignal::kNone;
+    if (start.backward_distance > 0.0) {
+      // Pair: cruise at backward_velocity, reached over half the segment (a = v^2 / L) so that
+      // the vehicle stops at its end.
+      const double v = params.backward_velocity;
+      result.path.partial_paths.insert(result.path.partial_paths.begin(),
+                                       reverse_segment(context, params, request.ego_pose, start));
+      result.path.pairs_terminal_velocity_and_accel.insert(result.path.pairs_terminal_velocity_and_accel.begin(),
+                                                           {v, -v * v / start.backward_distance});
+    }
+    publish_checked(result, checker, margin, params);
+    finish(result);
   };
 
   // Each (start, planner) pair is planned once, on first use; the margin ladder only re-reads
@@ -597,10 +599,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
       result.evaluation_table.push_back(
           {planners[pi]->type(), margin, start.backward_distance, sel.outcome, sel.detail});
       if (sel.chosen != nullptr) {
-        accept(*sel.chosen, planners[pi]->type());
-        prepend_reverse(start);
-        publish_checked(result, checker, margin, params);
-        finish(result);
+        accept(*sel.chosen, planners[pi]->type(), start, margin);
         return result;
       }
       if (result.stopped != StopReason::kNone) break;
@@ -625,9 +624,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
       result.evaluation_table.push_back(
           {planner->type(), smallest_margin, 0.0, sel.outcome, sel.chosen != nullptr ? "shunting" : sel.detail});
       if (sel.chosen != nullptr) {
-        accept(*sel.chosen, planner->type());
-        publish_checked(result, checker, smallest_margin, params);
-        finish(result);
+        accept(*sel.chosen, planner->type(), StartCandidate{request.ego_pose, 0.0}, smallest_margin);
         return result;
       }
       if (result.stopped != StopReason::kNone) break;
@@ -653,10 +650,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
       result.evaluation_table.push_back(
           {PlannerType::kFreespace, margin, start.backward_distance, sel.outcome, sel.detail});
       if (sel.chosen != nullptr) {
-        accept(*sel.chosen, PlannerType::kFreespace);
-        prepend_reverse(start);
-        publish_checked(result, checker, margin, params);
-        finish(result);
+        accept(*sel.chosen, PlannerType::kFreespace, start, margin);
         return result;
       }
       if (fallback.stopped != StopReason::kNone) break;  // the budget too: it is spent
