@@ -213,6 +213,26 @@ TEST(BoundedWork, CostmapBuildHonoursTheStopCondition) {
   EXPECT_FALSE(small.occupied(1, 1));
 }
 
+// A grid's cell size is bounded before anything is built from it: a fuzzed 1e-308 m cell once
+// overflowed the collision checker's cell counts (UBSan, fuzz_request).
+TEST(BoundedWork, GridCellSizeIsBoundedNamingTheField) {
+  PullOutRequest req = test::straight_shoulder_request();
+  const auto with_cells_of = [&](double resolution) {
+    req.occupancy_grid = OccupancyGrid{resolution, {}, 4, 4, std::vector<std::int8_t>(16, 0)};
+    return planner().validate(req);
+  };
+  for (const double bad : {1e-308, 1e-3, 5.5, 1e300}) {
+    const auto issues = with_cells_of(bad);
+    ASSERT_EQ(issues.size(), 1U) << bad << ": " << format_issues(issues);
+    EXPECT_EQ(issues.front().field, "occupancy_grid.resolution_m");
+    EXPECT_NE(issues.front().problem.find("is outside [0.01, 5] m"), std::string::npos) << issues.front().problem;
+  }
+  for (const double good : {0.01, 0.2, 5.0}) EXPECT_TRUE(with_cells_of(good).empty()) << good;
+  req.occupancy_grid->resolution_m = 1e-308;
+  const PlanningResult r = planner().plan(req);
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
+}
+
 // ---- the crop itself ----
 
 TEST(LaneCrop, KeepsTheStretchNearTheSquare) {

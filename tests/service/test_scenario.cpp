@@ -310,6 +310,14 @@ TEST(Scenario, GridSizeOfAnyMagnitudeIsChecked) {
   EXPECT_TRUE(any_starts_with(p, "grid.size: required")) << dump(p);
 }
 
+TEST(Scenario, GridCellSizeIsBounded) {
+  for (const char* resolution : {"1e-308", "0", "-0.5", "5.5", ".nan"}) {
+    const auto p = problems_of(std::string(kPoses) + "grid:\n  resolution: " + resolution + "\n  size: [10, 5]\n");
+    EXPECT_TRUE(any_starts_with(p, "grid.resolution: within [0.01, 5] [m]")) << resolution << ": " << dump(p);
+  }
+  EXPECT_TRUE(problems_of(std::string(kPoses) + "grid:\n  resolution: 0.01\n  size: [10, 5]\n").empty());
+}
+
 TEST(Scenario, GridFromAMapServerImage) {
   // A 4 x 3 P2 image: black (occupied), white (free), grey (unknown); the top row first.
   const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_map_" + std::to_string(::getpid()));

@@ -202,8 +202,11 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
   if (r.occupancy_grid) {
     const OccupancyGrid& g = *r.occupancy_grid;
     const std::size_t cells = static_cast<std::size_t>(g.width) * g.height;
-    if (c.finite("occupancy_grid.resolution_m", g.resolution_m) && g.resolution_m <= 0.0) {
-      c.add("occupancy_grid.resolution_m", "must be positive");
+    if (c.finite("occupancy_grid.resolution_m", g.resolution_m) &&
+        !(g.resolution_m >= kMinGridResolution && g.resolution_m <= kMaxGridResolution)) {
+      std::ostringstream os;
+      os << g.resolution_m << " m is outside [" << kMinGridResolution << ", " << kMaxGridResolution << "] m";
+      c.add("occupancy_grid.resolution_m", os.str());
     }
     c.pose("occupancy_grid.origin", g.origin);
     if (c.count("occupancy_grid", cells, limits.max_grid_cells, "cells") && g.data.size() != cells) {

@@ -17,6 +17,16 @@ namespace {
 
 constexpr long kMaxCells = 64L * 1024L * 1024L;
 
+bool resolution_ok(double resolution) {
+  return resolution >= kMinGridResolution && resolution <= kMaxGridResolution;  // false for NaN
+}
+
+std::string resolution_range() {
+  std::ostringstream os;
+  os << "within [" << kMinGridResolution << ", " << kMaxGridResolution << "] [m]";
+  return os.str();
+}
+
 // The next header token of a PGM file, skipping whitespace and '#' comments.
 bool next_token(const std::string& data, std::size_t& pos, std::string& token) {
   token.clear();
@@ -120,8 +130,10 @@ bool load_map_server_grid(const std::string& yaml_file, const std::string& key_p
   int negate = 0;
   std::string mode = "trinary";
   if (!r.read("image", image)) problems.push_back(r.key_path("image") + ": required");
-  if (!r.read("resolution", resolution) || !(resolution > 0.0)) {
-    problems.push_back(r.key_path("resolution") + ": required, > 0 [m]");
+  if (!r.read("resolution", resolution)) {
+    problems.push_back(r.key_path("resolution") + ": required, " + resolution_range());
+  } else if (!resolution_ok(resolution)) {
+    problems.push_back(r.key_path("resolution") + ": " + resolution_range());
   }
   r.read("occupied_thresh", occupied);
   r.read("free_thresh", free);
@@ -178,7 +190,7 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
   }
   double resolution = 0.2;
   r.read("resolution", resolution);
-  if (!(resolution > 0.0)) problems.push_back("grid.resolution: must be > 0 [m]");
+  if (!resolution_ok(resolution)) problems.push_back("grid.resolution: " + resolution_range());
   Pose2 origin;
   {
     yaml_fields::MapReader o(r.get("origin"), "grid.origin", problems);

@@ -82,8 +82,14 @@ struct Object {
 
 // An occupancy grid in the ROS convention: row-major from `origin`, cells 0 (free) .. 100
 // (occupied), -1 unknown.
+// The cell sizes [m] a given occupancy grid may have (a request's, a scenario's): 1 cm to 5 m. Finer
+// cells would make the collision checker's cell counts overflow (a 1e-308 m cell is not a grid);
+// coarser ones would not show the gaps the planner drives through.
+inline constexpr double kMinGridResolution = 0.01;
+inline constexpr double kMaxGridResolution = 5.0;
+
 struct OccupancyGrid {
-  double resolution_m{0.2};
+  double resolution_m{0.2};  // [kMinGridResolution, kMaxGridResolution]
   Pose2 origin;
   std::uint32_t width{0};
   std::uint32_t height{0};
