@@ -229,7 +229,7 @@ TEST(BoundedWork, GridCellSizeIsBoundedNamingTheField) {
   }
   for (const double good : {0.01, 0.2, 5.0}) EXPECT_TRUE(with_cells_of(good).empty()) << good;
   req.occupancy_grid->resolution_m = 1e-308;
-  const PlanningResult r = planner().plan(req);
+  const PlanningResult r = planner().plan(req, StopCondition());
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
 }
 
