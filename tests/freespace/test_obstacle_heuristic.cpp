@@ -46,9 +46,13 @@ double brute_distance(const Map& m, const std::vector<std::pair<int, int>>& occu
   return best * kRes;
 }
 
+// Several turning rooms: where a costmap cell has room to turn, the heuristic tells so from the
+// summed-area table without the distance transform (search_support.cpp, rate()); the oracle scans
+// brute-force distances. Room lengths on, just off and between whole cells.
 TEST(ObstacleHeuristic, LazySearchTowardsTheRootGivesDijkstraDistances) {
   std::mt19937 rng(13);
-  for (int trial = 0; trial < 2; ++trial) {
+  constexpr double kTurningRooms[] = {1.5, 0.95, 2.25, 1.0 + 1e-9, 0.7};
+  for (int trial = 0; trial < 6; ++trial) {
     const Map m = random_map(rng);
     const Costmap costmap({}, kRes, m.w, m.h, m.occ);
     std::vector<std::pair<int, int>> occupied;
@@ -60,7 +64,7 @@ TEST(ObstacleHeuristic, LazySearchTowardsTheRootGivesDijkstraDistances) {
     fd::ObstacleHeuristicConfig config;
     config.half_width = 0.6;
     config.cell_size = kRes * kFactor;
-    config.turning_room = 1.5;
+    config.turning_room = trial < 2 ? 1.5 : kTurningRooms[trial - 1];
     config.narrow_penalty = 3.0;
     // The documented rates, from brute-force distances.
     const int cw = m.w / kFactor, ch = m.h / kFactor;

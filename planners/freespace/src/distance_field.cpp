@@ -138,26 +138,32 @@ void DistanceField::row_segment(int iy, int x0, int x1, float* out) const {
     const double v = g[k];
     return v * v;
   };
-  // A cell's nearest occupied cell lies no farther than |x - k| + g(k) for any column k (the
-  // L1 distance to column k's nearest one; g = 0 on the border columns): the least of these over
-  // the columns up to kSegmentCells beyond the segment on either side (two running minima) bounds
-  // each cell's distance (as does the border), and the columns beyond the largest bound take no
-  // part.
+  // A cell's nearest occupied cell lies no farther than |x - k| + g(k) for any column k (the L1
+  // distance to column k's nearest one; g = 0 on the border columns): the least of these over the
+  // columns (two running minima, from the left and from the right) bounds each cell's distance
+  // (as does the border), and the columns beyond the largest bound take no part. The running
+  // minimum at x0 needs only the columns closer to x0 than the least found so far (a farther one
+  // cannot beat it), a few in a lot, where the whole segment's width on either side was walked
+  // before; likewise at x1 - 1. Any valid bound gives the same distances (integers, the minimum
+  // over the window holding the nearest occupied cell); a tighter one a shorter envelope.
   const auto g_at = [&](int k) -> std::int64_t { return k < 0 || k >= width_ ? 0 : g[k]; };
-  const int e0 = std::max(-1, x0 - kSegmentCells);
-  const int e1 = std::min(width_, x1 - 1 + kSegmentCells);
   std::array<std::int64_t, kSegmentCells> forward;
-  std::int64_t run = std::numeric_limits<std::int32_t>::max();
-  for (int k = e0; k < x1; ++k) {
-    run = std::min(run + 1, g_at(k));
-    if (k >= x0) forward[k - x0] = run;
+  std::int64_t run = g_at(x0);
+  // (at most a segment's width away, as before: a bound, never a long walk on an empty map)
+  const int left_end = std::max(-1, x0 - kSegmentCells);
+  const int right_end = std::min(width_, x1 - 1 + kSegmentCells);
+  for (int k = x0 - 1; k >= left_end && x0 - k < run; --k) run = std::min(run, (x0 - k) + g_at(k));
+  forward[0] = run;
+  for (int k = x0 + 1; k < x1; ++k) {
+    run = std::min<std::int64_t>(run + 1, g[k]);
+    forward[k - x0] = run;
   }
+  run = g_at(x1 - 1);
+  for (int k = x1; k <= right_end && k - (x1 - 1) < run; ++k) run = std::min(run, (k - (x1 - 1)) + g_at(k));
   std::int64_t reach = 0;
-  run = std::numeric_limits<std::int32_t>::max();
-  for (int k = e1; k >= x0; --k) {
-    run = std::min(run + 1, g_at(k));
-    if (k < x1)
-      reach = std::max(reach, std::min({run, forward[k - x0], std::int64_t{k} + 1, std::int64_t{width_} - k}));
+  for (int k = x1 - 1; k >= x0; --k) {
+    if (k < x1 - 1) run = std::min<std::int64_t>(run + 1, g[k]);
+    reach = std::max(reach, std::min({run, forward[k - x0], std::int64_t{k} + 1, std::int64_t{width_} - k}));
   }
   const int lo = static_cast<int>(std::max<std::int64_t>(-1, x0 - reach));
   const int hi = static_cast<int>(std::min<std::int64_t>(width_, x1 - 1 + reach));

@@ -125,6 +125,7 @@ class ObstacleHeuristic {
   double cell_size_{0.0};
   std::vector<float> distance_;
   std::vector<float> rate_;  // NaN until computed
+  int open_reach_{-1};       // [costmap cells] see rate(); -1: not used
   int toward_x_{0};          // the coarse cell of `toward`
   int toward_y_{0};
   using Item = std::pair<float, std::int32_t>;  // (distance + estimate, cell)
@@ -148,6 +149,7 @@ class NodeTable {
   std::vector<std::int32_t> values_;
   std::size_t size_{0};
   std::uint64_t mask_{0};
+  int shift_{64};  // 64 - log2(slots): a hash's top bits index the slots
 };
 
 constexpr std::uint64_t kEmptyKey = std::numeric_limits<std::uint64_t>::max();
