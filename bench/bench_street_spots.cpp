@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <iostream>
 #include <map>
 #include <string>
@@ -77,6 +78,13 @@ struct Tally {
   std::map<std::string, int> by_planner;  // paths found per planner type
 };
 
+// This thread's CPU time [ms]: less disturbed by a loaded machine than the wall clock.
+double thread_cpu_ms() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+
 int direction_changes(const PullOutPath& path) {
   int n = 0;
   for (std::size_t k = 0; k + 1 < path.partial_paths.size(); ++k) {
@@ -90,6 +98,11 @@ int direction_changes(const PullOutPath& path) {
 int main(int argc, char** argv) {
   // --why: the evaluation table's last row of every spot the shunting planner leaves unsolved.
   const bool why = argc > 1 && std::string(argv[1]) == "--why";
+  // --spots: one line per spot for the shipped search (time, thread CPU time, outcome, its
+  // evaluation table's freespace rows).
+  // --one right|left LANES RADIUS KERB SLACK: that spot alone, shipped search, with --spots' line.
+  const bool one = argc == 7 && std::string(argv[1]) == "--one";
+  const bool spots = one || (argc > 1 && std::string(argv[1]) == "--spots");
   const VehicleInfo v;
   struct Planner {
     const char* name;
@@ -121,14 +134,22 @@ int main(int argc, char** argv) {
                                    (radius > 0 ? "R " + std::to_string(static_cast<int>(radius)) + " m" : "straight");
         for (double kerb : {0.15, 0.3, 0.5}) {
           for (double slack : {3.0, 2.0, 1.5, 1.0, 0.8}) {
+            if (one && (right_hand != (std::string(argv[2]) == "right") || road_lanes != std::atoi(argv[3]) ||
+                        std::abs(radius - std::atof(argv[4])) > 1e-9 || std::abs(kerb - std::atof(argv[5])) > 1e-9 ||
+                        std::abs(slack - std::atof(argv[6])) > 1e-9)) {
+              continue;
+            }
             const Spot sp{right_hand, road_lanes, kerb, slack, radius};
             const Street st = street::make_street(sp, v);
             for (const Planner& pl : planners) {
+              if (spots && std::string(pl.name) != "default search") continue;
               const StartPlanner planner(v, pl.params);
+              const double cpu0 = thread_cpu_ms();
               const auto t0 = std::chrono::steady_clock::now();
               const PlanningResult r = planner.plan(st.request, StopCondition());
               const double ms =
                   std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+              const double cpu = thread_cpu_ms() - cpu0;
               bool ok = r.outcome == PlanningResult::Outcome::kFound;
               if (ok) {
                 const std::string why = check(r.path, st, v);
@@ -137,6 +158,15 @@ int main(int argc, char** argv) {
                   oracle_failures.push_back(std::string(pl.name) + " " + family + " kerb " + std::to_string(kerb) +
                                             " slack " + std::to_string(slack) + ": " + why);
                 }
+              }
+              if (spots && std::string(pl.name) == "default search") {
+                std::string rows;
+                for (const auto& row : r.evaluation_table) {
+                  if (row.planner == PlannerType::kFreespace) rows += " | " + describe(row);
+                }
+                std::printf("spot: %s kerb %.2f slack %.1f: %s %s %.1f ms (cpu %.1f ms)%s\n", family.c_str(), kerb,
+                            slack, ok ? "solved" : "unsolved", ok ? to_string(r.path.planner_type) : "-", ms, cpu,
+                            rows.c_str());
               }
               if (why && !ok && std::string(pl.name) == "geometric with shunts" && !r.evaluation_table.empty()) {
                 std::printf("unsolved: %s kerb %.2f slack %.1f: %s\n", family.c_str(), kerb, slack,

@@ -131,6 +131,55 @@ TEST(Costmap, PolygonsRasteriseConservatively) {
   EXPECT_TRUE(m.occupied(i, j));  // [6.0, 6.25] x [3.0, 3.25] holds the box corner (6.1, 3.1)
 }
 
+TEST(Costmap, InsideDrivableIsTheEvenOddRuleOverThePolygons) {
+  // Two lanes of a 30 m bend (hundreds of edges each, the inner one clockwise) and a square that
+  // sticks out of the grid; 0.1 m cells. inside_drivable looks only at the edges near a point's
+  // row: its answer must be point_in_polygon's over the polygons (grid frame), also for points on
+  // vertex heights and row boundaries, outside the grid's rows, and on a vertex.
+  const auto lane = [](double r_in, double r_out, bool clockwise) {
+    Polygon p;
+    for (int k = 0; k <= 200; ++k) p.emplace_back(r_in * std::cos(0.01 * k), r_in * std::sin(0.01 * k) - 25.0);
+    for (int k = 200; k >= 0; --k) p.emplace_back(r_out * std::cos(0.01 * k), r_out * std::sin(0.01 * k) - 25.0);
+    if (clockwise) std::reverse(p.begin(), p.end());
+    return p;
+  };
+  const std::vector<Polygon> lanes{
+      lane(27.0, 30.0, false), lane(30.0, 33.0, true), {{20.0, -2.0}, {26.0, -2.0}, {26.0, 40.0}, {20.0, 40.0}}};
+  Aabb extent;
+  extent.extend({15.0, -26.0});
+  extent.extend({34.0, 30.0});
+  const Costmap m = Costmap::from_polygons(extent, 0.1, lanes, {}, {});
+  std::vector<Polygon> grid_lanes;
+  for (const Polygon& p : lanes) {
+    Polygon g;
+    for (const Vec2& v : p) g.push_back(m.to_grid(v));
+    grid_lanes.push_back(g);
+  }
+  const auto expected = [&](const Vec2& q) {
+    return std::any_of(grid_lanes.begin(), grid_lanes.end(), [&](const Polygon& g) { return point_in_polygon(g, q); });
+  };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> x(-5.0, m.width() + 5.0);
+  std::uniform_real_distribution<double> y(-5.0, m.height() + 5.0);
+  std::vector<Vec2> points;
+  for (int k = 0; k < 20000; ++k) points.emplace_back(x(rng), y(rng));
+  for (const Polygon& g : grid_lanes) {
+    for (const Vec2& v : g) {
+      points.push_back(v);
+      points.emplace_back(x(rng), v.y());
+      points.emplace_back(v.x() + 0.01, std::floor(v.y()));
+      points.emplace_back(v.x() - 0.01, std::floor(v.y()) + 1.0);
+    }
+  }
+  int inside = 0;
+  for (const Vec2& q : points) {
+    ASSERT_EQ(m.inside_drivable(q), expected(q)) << q.x() << ", " << q.y();
+    inside += expected(q) ? 1 : 0;
+  }
+  EXPECT_GT(inside, 1000);  // the points test both answers
+  EXPECT_LT(inside, static_cast<int>(points.size()) - 1000);
+}
+
 TEST(Costmap, PolygonsOfAnySizeRasterise) {
   // Coordinates far beyond the range of int cell indices: clamped to the grid, not converted.
   Costmap map = empty_map(10, 10, 1.0);

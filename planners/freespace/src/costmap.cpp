@@ -141,6 +141,7 @@ Costmap Costmap::from_polygons(const Aabb& extent, double resolution, const std:
     std::vector<Vec2> g;
     g.reserve(poly.size());
     for (const Vec2& p : poly) g.push_back(map.to_grid(p));
+    map.drivable_rows_.push_back(edge_rows(g, h));
     map.drivable_.push_back(std::move(g));
   }
   std::vector<Polygon> blocked;
@@ -168,8 +169,68 @@ void Costmap::partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) co
 
 bool Costmap::inside_drivable(const Vec2& p_G) const {
   if (drivable_.empty()) return true;
-  return std::any_of(drivable_.begin(), drivable_.end(),
-                     [&](const std::vector<Vec2>& poly) { return poly.size() >= 3 && point_in_polygon(poly, p_G); });
+  const double y = p_G.y();
+  if (!(y >= 0.0 && y < static_cast<double>(height_))) {
+    return std::any_of(drivable_.begin(), drivable_.end(),
+                       [&](const std::vector<Vec2>& poly) { return poly.size() >= 3 && point_in_polygon(poly, p_G); });
+  }
+  // point_in_polygon's even-odd count over the edges that can cross the height y (the others do
+  // not change it), with its arithmetic: the same answer.
+  const auto row = static_cast<std::size_t>(y);
+  for (std::size_t k = 0; k < drivable_.size(); ++k) {
+    const std::vector<Vec2>& poly = drivable_[k];
+    if (poly.size() < 3) continue;
+    const EdgeRows& rows = drivable_rows_[k];
+    bool inside = false;
+    for (std::uint32_t e = rows.row_start[row]; e < rows.row_start[row + 1]; ++e) {
+      const std::uint32_t i = rows.edges[e];
+      const Vec2& a = poly[i];
+      const Vec2& b = poly[i == 0 ? poly.size() - 1 : i - 1];
+      if ((a.y() > y) != (b.y() > y)) {
+        const double x_cross = a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
+        if (p_G.x() < x_cross) inside = !inside;
+      }
+    }
+    if (inside) return true;
+  }
+  return false;
+}
+
+Costmap::EdgeRows Costmap::edge_rows(const std::vector<Vec2>& poly, int height) {
+  EdgeRows out;
+  const auto rows = static_cast<std::size_t>(std::max(0, height));
+  // Rows floor(min y) .. floor(max y) (clamped to the grid) hold the edge: every height y in a row
+  // r with min y <= y < max y, the edge's crossing condition, has floor(min y) <= r <= floor(max y).
+  // A non-finite coordinate puts the edge in every row.
+  const auto span = [&](std::size_t i, std::size_t& r0, std::size_t& r1) {
+    const Vec2& a = poly[i];
+    const Vec2& b = poly[i == 0 ? poly.size() - 1 : i - 1];
+    const double lo = std::min(a.y(), b.y());
+    const double hi = std::max(a.y(), b.y());
+    if (!std::isfinite(lo) || !std::isfinite(hi)) {
+      r0 = 0;
+      r1 = rows - 1;
+      return;
+    }
+    r0 = static_cast<std::size_t>(clamped_int(std::floor(lo), 0, height - 1));
+    r1 = static_cast<std::size_t>(clamped_int(std::floor(hi), 0, height - 1));
+  };
+  out.row_start.assign(rows + 1, 0);
+  if (rows == 0) return out;
+  std::size_t r0 = 0;
+  std::size_t r1 = 0;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    span(i, r0, r1);
+    for (std::size_t r = r0; r <= r1; ++r) ++out.row_start[r + 1];
+  }
+  for (std::size_t r = 0; r < rows; ++r) out.row_start[r + 1] += out.row_start[r];
+  out.edges.resize(out.row_start[rows]);
+  std::vector<std::uint32_t> fill(out.row_start.begin(), out.row_start.end() - 1);
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    span(i, r0, r1);
+    for (std::size_t r = r0; r <= r1; ++r) out.edges[fill[r]++] = static_cast<std::uint32_t>(i);
+  }
+  return out;
 }
 
 bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& stop, std::size_t lane_edges) {

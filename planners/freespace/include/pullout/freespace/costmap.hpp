@@ -162,6 +162,16 @@ class Costmap {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> partial_;
   std::vector<Shape> shapes_;
   std::vector<std::vector<Vec2>> drivable_;
+  // Per drivable polygon, per grid row: the edges (index i: from vertex i - 1 to vertex i, as
+  // point_in_polygon walks them) whose y range meets that row, so that inside_drivable tests only
+  // those (a bend's lanes have hundreds of edges; a row meets a few). Rows' lists in edge_rows_
+  // from row_start_[r] to row_start_[r + 1] (height + 1 entries per polygon).
+  struct EdgeRows {
+    std::vector<std::uint32_t> row_start;
+    std::vector<std::uint32_t> edges;
+  };
+  static EdgeRows edge_rows(const std::vector<Vec2>& poly, int height);
+  std::vector<EdgeRows> drivable_rows_;
 };
 
 // The column extent of a convex polygon (grid frame, cell units) within the horizontal strip
