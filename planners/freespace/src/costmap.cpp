@@ -167,6 +167,17 @@ void Costmap::partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) co
   for (; it != partial_.end() && it->first == cell; ++it) out.push_back(it->second);
 }
 
+void Costmap::partial_shapes_in_row(int c0, int c1, int iy, std::vector<std::uint32_t>& out) const {
+  const auto first = static_cast<std::uint32_t>(index(c0, iy));
+  const auto last = static_cast<std::uint32_t>(index(c1, iy));
+  auto it = std::lower_bound(partial_.begin(), partial_.end(), std::make_pair(first, std::uint32_t{0}));
+  // The list is sorted by cell: its entries for the row's cells follow one another. Only occupied
+  // cells count, as for the callers of partial_shapes.
+  for (; it != partial_.end() && it->first <= last; ++it) {
+    if (occupied_[it->first] != 0) out.push_back(it->second);
+  }
+}
+
 bool Costmap::inside_drivable(const Vec2& p_G) const {
   if (drivable_.empty()) return true;
   const double y = p_G.y();

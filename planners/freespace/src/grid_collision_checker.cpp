@@ -66,12 +66,18 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
       continue;
     }
     const double slope = (b.x() - a.x()) / (b.y() - a.y());
-    for (int j = ja; j <= jb; ++j) {
-      const double y0 = std::max(ya, static_cast<double>(j));
-      const double y1 = std::min(yb, j + 1.0);
-      add(j, a.x() + (y0 - a.y()) * slope, a.x() + (y1 - a.y()) * slope);
+    // Row j's part runs from y = max(ya, j) to min(yb, j + 1): from ya in the first row, j
+    // between rows, to yb in the last. Each x is computed once and serves both rows it bounds
+    // (the same expression, so the same value as computing it per row).
+    const double x_start = a.x() + (ya - a.y()) * slope;
+    double x_prev = x_start;
+    for (int j = ja; j < jb; ++j) {
+      const double x_next = a.x() + ((j + 1.0) - a.y()) * slope;
+      add(j, x_prev, x_next);
+      x_prev = x_next;
     }
-    if (on_boundary) add(ja - 1, a.x() + (ya - a.y()) * slope, a.x() + (ya - a.y()) * slope);
+    add(jb, x_prev, a.x() + (yb - a.y()) * slope);
+    if (on_boundary) add(ja - 1, x_start, x_start);
   }
   for (int r = 0; r < rows; ++r) {
     const auto k = static_cast<std::size_t>(r);
@@ -83,9 +89,7 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
     const int c1 = cell_last(hi[k]);
     if (m.occupied_in_box_inside(c0, j, c1, j) == 0) continue;
     if (partial == nullptr || m.hard_in_box_inside(c0, j, c1, j) > 0) return true;
-    for (int i = c0; i <= c1; ++i) {
-      if (m.occupied(i, j)) m.partial_shapes(i, j, *partial);
-    }
+    m.partial_shapes_in_row(c0, c1, j, *partial);
   }
   return false;
 }
