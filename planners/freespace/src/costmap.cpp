@@ -172,9 +172,10 @@ void Costmap::partial_shapes_in_row(int c0, int c1, int iy, std::vector<std::uin
   const auto last = static_cast<std::uint32_t>(index(c1, iy));
   auto it = std::lower_bound(partial_.begin(), partial_.end(), std::make_pair(first, std::uint32_t{0}));
   // The list is sorted by cell: its entries for the row's cells follow one another. Only occupied
-  // cells count, as for the callers of partial_shapes.
+  // cells count, as for the callers of partial_shapes. A shape usually covers several neighbouring
+  // cells: an id equal to the last one appended is left out (the callers want the set).
   for (; it != partial_.end() && it->first <= last; ++it) {
-    if (occupied_[it->first] != 0) out.push_back(it->second);
+    if (occupied_[it->first] != 0 && (out.empty() || out.back() != it->second)) out.push_back(it->second);
   }
 }
 

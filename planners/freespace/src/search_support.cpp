@@ -54,22 +54,28 @@ bool sweep_free(const GridCollisionChecker& checker, const Arc& arc, double sign
   return true;
 }
 
+// arc_free after its end test passed with end_clearance.
+bool sweep_to_free_end(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+                       double end_clearance) {
+  const double total = std::abs(distance);
+  const double sign = distance < 0.0 ? -1.0 : 1.0;
+  const double factor = checker.sweep_factor(arc.curvature());
+  const double covered = start_clearance / factor;              // [0, covered] is known free
+  const double uncovered_end = total - end_clearance / factor;  // so is [uncovered_end, total]
+  if (covered >= uncovered_end) return true;
+  return sweep_free(checker, arc, sign, std::max(0.0, covered), std::min(total, uncovered_end));
+}
+
 }  // namespace
 
 bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
               double& end_clearance) {
-  const double total = std::abs(distance);
-  const double sign = distance < 0.0 ? -1.0 : 1.0;
-  const double factor = checker.sweep_factor(arc.curvature());
   double c = 1.0;
   double sn = 0.0;
   // The end first: where the search stops, tested exactly (and the likeliest to collide).
   const Pose2 end = arc.at(distance, c, sn);
   if (checker.collides(end, c, sn, end_clearance)) return false;
-  const double covered = start_clearance / factor;              // [0, covered] is known free
-  const double uncovered_end = total - end_clearance / factor;  // so is [uncovered_end, total]
-  if (covered >= uncovered_end) return true;
-  return sweep_free(checker, arc, sign, std::max(0.0, covered), std::min(total, uncovered_end));
+  return sweep_to_free_end(checker, arc, start_clearance, distance, end_clearance);
 }
 
 double free_prefix(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
@@ -86,17 +92,21 @@ double free_prefix(const GridCollisionChecker& checker, const Arc& arc, double s
   double last_free = 0.0;  // the start is free
   double s = std::max(min_length, start_clearance / factor);
   double clearance = 0.0;
+  double last_clearance = 0.0;
   while (true) {
     const double at = std::min(s, total);
     const Pose2 pose = arc.at(sign * at, c, sn);  // (before the call: it sets c and sn)
     if (checker.collides(pose, c, sn, clearance)) break;
     last_free = at;
+    last_clearance = clearance;
     if (at >= total) break;
     s = at + step + clearance / factor;
   }
   if (last_free < min_length) return 0.0;
+  // The end pose of the motion to last_free was just tested free (the same pose: arc_free would
+  // compute it from the same distance): its sweep is all that is left to test.
+  if (sweep_to_free_end(checker, arc, start_clearance, sign * last_free, last_clearance)) return last_free;
   double end_clearance = 0.0;
-  if (arc_free(checker, arc, start_clearance, sign * last_free, end_clearance)) return last_free;
   // The sweep to it touches: bisection for the longest free prefix (free at lo, not at hi).
   double lo = min_length;
   if (!arc_free(checker, arc, start_clearance, sign * lo, end_clearance)) return 0.0;

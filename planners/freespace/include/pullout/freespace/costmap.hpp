@@ -84,7 +84,8 @@ class Costmap {
   // Appends the indices (into shapes()) of the shapes meeting partial cell (ix, iy) in the grid.
   void partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) const;
   // The same for the occupied cells c0..c1 of row iy (inside the grid), in column order: what
-  // partial_shapes would append cell by cell, with one search of the list instead of one per cell.
+  // partial_shapes would append cell by cell, with one search of the list instead of one per cell,
+  // less the ids equal to the one appended just before (the same set, fewer repeats).
   void partial_shapes_in_row(int c0, int c1, int iy, std::vector<std::uint32_t>& out) const;
   const std::vector<Shape>& shapes() const { return shapes_; }
   // Whether grid point p (cell units) lies inside the drivable polygons (always true for a costmap
