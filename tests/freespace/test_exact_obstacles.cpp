@@ -159,5 +159,122 @@ TEST(ExactObstacles, CheckerAgreesWithPolygonOracleNearPolygonsAndLaneEdges) {
   EXPECT_GT(free_near, 300) << "free poses within a cell of a shape";
 }
 
+// A random star-shaped polygon around centre (convex or not): n vertices at increasing angles,
+// radii between r_min and r_max.
+std::vector<Vec2> random_star(std::mt19937& rng, const Vec2& centre, double r_min, double r_max) {
+  const int n = std::uniform_int_distribution<int>(3, 9)(rng);
+  std::uniform_real_distribution<double> radius(r_min, r_max), jitter(0.1, 0.9);
+  const double start = std::uniform_real_distribution<double>(-kPi, kPi)(rng);
+  std::vector<Vec2> out;
+  for (int i = 0; i < n; ++i) {
+    const double a = start + 2.0 * kPi * (i + jitter(rng)) / n;
+    const double r = radius(rng);
+    out.emplace_back(centre.x() + r * std::cos(a), centre.y() + r * std::sin(a));
+  }
+  return out;
+}
+
+// The fast paths of the exact test (rows of a footprint piece, the partial cells' shapes collected
+// a row at a time) against the oracle on random maps: random footprints (short ones checked in one
+// piece, long and wide ones in several), random cell sizes, many random obstacles of all sizes,
+// poses near the obstacles' boundaries. A wrong early out or a cell left out of a row shows as
+// "free" where the oracle has an overlap.
+TEST(ExactObstacles, RandomFootprintsAgreeWithPolygonOracleOnRandomMaps) {
+  std::mt19937 rng(1302);
+  std::uniform_real_distribution<double> unit(0.0, 1.0), yaw(-kPi, kPi);
+  int compared = 0, collisions = 0, free_near = 0;
+  for (int map_index = 0; map_index < 12; ++map_index) {
+    const double res = std::uniform_real_distribution<double>(0.05, 0.3)(rng);
+    const double size = 30.0;
+    const std::vector<Vec2> lane{{0.0, 0.0}, {size, 0.0}, {size, size}, {0.0, size}};
+    std::vector<std::pair<Vec2, Vec2>> outline;
+    for (std::size_t k = 0; k < lane.size(); ++k) outline.emplace_back(lane[k], lane[(k + 1) % lane.size()]);
+    std::vector<std::vector<Vec2>> obstacles;
+    const int count = std::uniform_int_distribution<int>(5, 25)(rng);
+    for (int i = 0; i < count; ++i) {
+      const Vec2 centre(3.0 + 24.0 * unit(rng), 3.0 + 24.0 * unit(rng));
+      const double r_max = std::uniform_real_distribution<double>(0.05, 2.5)(rng);
+      obstacles.push_back(random_star(rng, centre, 0.3 * r_max, r_max));
+    }
+    std::vector<Polygon> polys;
+    for (const auto& o : obstacles) polys.push_back(Polygon(o.begin(), o.end()));
+    Aabb extent;
+    for (const Vec2& p : lane) extent.extend(p);
+    extent.extend(extent.min - Vec2(1.0, 1.0));
+    extent.extend(extent.max + Vec2(1.0, 1.0));
+    const Costmap map = Costmap::from_polygons(extent, res, {Polygon(lane.begin(), lane.end())}, outline, polys);
+    ASSERT_TRUE(map.has_partial());
+    for (int f = 0; f < 4; ++f) {
+      const double front = std::uniform_real_distribution<double>(0.2, 6.0)(rng);
+      const double rear = std::uniform_real_distribution<double>(0.0, 2.0)(rng);
+      const double left = std::uniform_real_distribution<double>(0.1, 1.8)(rng);
+      const double right = std::uniform_real_distribution<double>(0.1, 1.8)(rng);
+      const GridCollisionChecker checker(map, Footprint{front, rear, left, right});
+      std::uniform_real_distribution<double> off(-(front + left), front + left);
+      for (int n = 0; n < 1500; ++n) {
+        const auto& b = obstacles[std::uniform_int_distribution<std::size_t>(0, obstacles.size() - 1)(rng)];
+        const std::size_t k = std::uniform_int_distribution<std::size_t>(0, b.size() - 1)(rng);
+        const Vec2 p = b[k] + unit(rng) * (b[(k + 1) % b.size()] - b[k]);
+        const Pose2 pose{p.x() + off(rng), p.y() + off(rng), yaw(rng)};
+        const auto rect = rectangle(pose, front, rear, left, right);
+        double d = lane_margin(rect, lane);
+        for (const auto& o : obstacles) d = std::min(d, polygon_distance(rect, o));
+        if (d != 0.0 && std::abs(d) <= kTolerance) continue;  // touching up to rounding
+        const bool expected = d <= 0.0;
+        ++compared;
+        collisions += expected ? 1 : 0;
+        free_near += (d > kTolerance && d < res) ? 1 : 0;
+        ASSERT_EQ(checker.collides(pose), expected)
+            << "map " << map_index << " res " << res << " footprint " << front << " " << rear << " " << left << " "
+            << right << " pose " << pose.x << " " << pose.y << " " << pose.yaw << " oracle distance " << d;
+      }
+    }
+  }
+  EXPECT_GT(compared, 70000);
+  EXPECT_GT(collisions, 10000);
+  EXPECT_GT(free_near, 1000) << "free poses within a cell of a shape";
+}
+
+// partial_shapes_in_row gives the set of shapes of the occupied cells of the row range, which the
+// cell-by-cell partial_shapes gives too, with no id repeated back to back.
+TEST(ExactObstacles, RowOfPartialShapesIsTheSetOfItsCellsShapes) {
+  std::mt19937 rng(2012);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Polygon> polys;
+  for (int i = 0; i < 40; ++i) {
+    const auto star = random_star(rng, Vec2(1.0 + 18.0 * unit(rng), 1.0 + 18.0 * unit(rng)), 0.05, 1.5);
+    polys.push_back(Polygon(star.begin(), star.end()));
+  }
+  const std::vector<Vec2> lane{{0.0, 0.0}, {20.0, 0.0}, {20.0, 20.0}, {0.0, 20.0}};
+  std::vector<std::pair<Vec2, Vec2>> outline;
+  for (std::size_t k = 0; k < lane.size(); ++k) outline.emplace_back(lane[k], lane[(k + 1) % lane.size()]);
+  Aabb extent;
+  extent.extend(Vec2(-1.0, -1.0));
+  extent.extend(Vec2(21.0, 21.0));
+  const Costmap map = Costmap::from_polygons(extent, 0.1, {Polygon(lane.begin(), lane.end())}, outline, polys);
+  ASSERT_TRUE(map.has_partial());
+  int nonempty = 0;
+  for (int n = 0; n < 3000; ++n) {
+    const int j = std::uniform_int_distribution<int>(0, map.height() - 1)(rng);
+    int c0 = std::uniform_int_distribution<int>(0, map.width() - 1)(rng);
+    int c1 = std::uniform_int_distribution<int>(0, map.width() - 1)(rng);
+    if (c0 > c1) std::swap(c0, c1);
+    std::vector<std::uint32_t> row;
+    map.partial_shapes_in_row(c0, c1, j, row);
+    std::vector<std::uint32_t> cells;
+    for (int i = c0; i <= c1; ++i) {
+      if (map.occupied(i, j)) map.partial_shapes(i, j, cells);
+    }
+    for (std::size_t k = 1; k < row.size(); ++k) ASSERT_NE(row[k], row[k - 1]);
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    ASSERT_EQ(row, cells) << "row " << j << " columns " << c0 << ".." << c1;
+    nonempty += row.empty() ? 0 : 1;
+  }
+  EXPECT_GT(nonempty, 1000);
+}
+
 }  // namespace
 }  // namespace pullout
