@@ -6,6 +6,7 @@
 #include <atomic>
 #include <random>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace pullout {
@@ -62,6 +63,23 @@ TEST(BoxCounts, MatchesCountingOnRandomGrids) {
             << b.c0 << "," << b.r0 << " .. " << b.c1 << "," << b.r1;
         ASSERT_EQ(counts.count(b.c0, b.r1, b.c0, b.r1, g.cells.data()), oracle(g, b.c0, b.r1, b.c0, b.r1));
       }
+    }
+  }
+}
+
+TEST(BoxCounts, RowCountsMatchCountingOnFreshTables) {
+  // Every row of a fresh table (so each band is first filled by count_row, including the rows
+  // whose next table row starts the next band), at random column ranges.
+  std::mt19937 rng(77);
+  for (const auto& [w, h] : {std::pair{37, 200}, std::pair{1, 65}, std::pair{130, 64}}) {
+    const Grid g = random_grid(w, h, 0.3, rng);
+    BoxCounts counts;
+    ASSERT_EQ(counts.build(g.cells.data(), g.width, g.height), StopReason::kNone);
+    for (int r = h - 1; r >= 0; --r) {
+      int c0 = std::uniform_int_distribution<int>(0, w - 1)(rng);
+      int c1 = std::uniform_int_distribution<int>(0, w - 1)(rng);
+      if (c0 > c1) std::swap(c0, c1);
+      ASSERT_EQ(counts.count_row(c0, c1, r, g.cells.data()), oracle(g, c0, r, c1, r)) << w << " x " << h << " row " << r;
     }
   }
 }

@@ -87,8 +87,8 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
     const int j = j0 + r;
     const int c0 = std::max(0, cell_first(lo[k]));
     const int c1 = cell_last(hi[k]);
-    if (m.occupied_in_box_inside(c0, j, c1, j) == 0) continue;
-    if (partial == nullptr || m.hard_in_box_inside(c0, j, c1, j) > 0) return true;
+    if (m.occupied_in_row_inside(c0, c1, j) == 0) continue;
+    if (partial == nullptr || m.hard_in_row_inside(c0, c1, j) > 0) return true;
     m.partial_shapes_in_row(c0, c1, j, *partial);
   }
   return false;

@@ -46,6 +46,14 @@ class BoxCounts {
     return hi[c1 + 1] - hi[c0] - lo[c1 + 1] + lo[c0];
   }
 
+  // count(c0, r, c1, r): one row, whose two table rows are neighbours in memory and usually in
+  // one band (then one readiness check).
+  int count_row(int c0, int c1, int r, const std::uint8_t* cells) const {
+    const std::int32_t* lo = row(r, cells);
+    const std::int32_t* hi = ((r + 1) >> kBandShift) == (r >> kBandShift) ? lo + stride_ : row(r + 1, cells);
+    return hi[c1 + 1] - hi[c0] - lo[c1 + 1] + lo[c0];
+  }
+
   std::size_t filled_bands() const { return bands_.count_ready(); }
 
  private:

@@ -81,6 +81,11 @@ class Costmap {
     if (hard_box_.empty()) return occupied_in_box_inside(c0, r0, c1, r1);
     return hard_box_.count(c0, r0, c1, r1, hard_.data());
   }
+  // The same for columns c0..c1 of row r alone (0 <= c0 <= c1 < width, 0 <= r < height).
+  int hard_in_row_inside(int c0, int c1, int r) const {
+    if (hard_box_.empty()) return occupied_in_row_inside(c0, c1, r);
+    return hard_box_.count_row(c0, c1, r, hard_.data());
+  }
   // Appends the indices (into shapes()) of the shapes meeting partial cell (ix, iy) in the grid.
   void partial_shapes(int ix, int iy, std::vector<std::uint32_t>& out) const;
   // The same for the occupied cells c0..c1 of row iy (inside the grid), in column order: what
@@ -134,6 +139,8 @@ class Costmap {
   int occupied_in_box_inside(int c0, int r0, int c1, int r1) const {
     return box_.count(c0, r0, c1, r1, occupied_.data());
   }
+  // occupied_in_box_inside(c0, r, c1, r), cheaper.
+  int occupied_in_row_inside(int c0, int c1, int r) const { return box_.count_row(c0, c1, r, occupied_.data()); }
 
  private:
   std::size_t index(int ix, int iy) const {
