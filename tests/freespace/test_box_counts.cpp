@@ -79,7 +79,8 @@ TEST(BoxCounts, RowCountsMatchCountingOnFreshTables) {
       int c0 = std::uniform_int_distribution<int>(0, w - 1)(rng);
       int c1 = std::uniform_int_distribution<int>(0, w - 1)(rng);
       if (c0 > c1) std::swap(c0, c1);
-      ASSERT_EQ(counts.count_row(c0, c1, r, g.cells.data()), oracle(g, c0, r, c1, r)) << w << " x " << h << " row " << r;
+      ASSERT_EQ(counts.count_row(c0, c1, r, g.cells.data()), oracle(g, c0, r, c1, r))
+          << w << " x " << h << " row " << r;
     }
   }
 }
