@@ -71,10 +71,25 @@ bool polygon_hits(const Costmap& m, const Vec2* q, std::size_t count, int j0, in
     // (the same expression, so the same value as computing it per row).
     const double x_start = a.x() + (ya - a.y()) * slope;
     double x_prev = x_start;
-    for (int j = ja; j < jb; ++j) {
-      const double x_next = a.x() + ((j + 1.0) - a.y()) * slope;
-      add(j, x_prev, x_next);
-      x_prev = x_next;
+    if (ja >= j0 && jb <= j1) {
+      // All of the edge's rows are in range (always, but at the grid's bottom row): no row test.
+      // Rounding is monotone, so x grows with y along the edge when slope >= 0 and shrinks when
+      // it is negative: which end of a row's part is its minimum is known.
+      double* row_lo = lo + (ja - j0);
+      double* row_hi = hi + (ja - j0);
+      const bool rising = slope >= 0.0;
+      for (int j = ja; j < jb; ++j, ++row_lo, ++row_hi) {
+        const double x_next = a.x() + ((j + 1.0) - a.y()) * slope;
+        *row_lo = std::min(*row_lo, rising ? x_prev : x_next);
+        *row_hi = std::max(*row_hi, rising ? x_next : x_prev);
+        x_prev = x_next;
+      }
+    } else {
+      for (int j = ja; j < jb; ++j) {
+        const double x_next = a.x() + ((j + 1.0) - a.y()) * slope;
+        add(j, x_prev, x_next);
+        x_prev = x_next;
+      }
     }
     add(jb, x_prev, a.x() + (yb - a.y()) * slope);
     if (on_boundary) add(ja - 1, x_start, x_start);
