@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <unordered_set>
 
 namespace pullout {
@@ -162,6 +163,34 @@ Polygon bounds_polygon(const Lane& lane) {
   const Polyline right(to_vecs(lane.right_bound));
   polygon.insert(polygon.end(), right.points().rbegin(), right.points().rend());
   return polygon;
+}
+
+namespace {
+
+bool identical_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+bool identical_points(const std::vector<Point2>& a, const std::vector<Point2>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!identical_bits(a[i].x, b[i].x) || !identical_bits(a[i].y, b[i].y)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool identical_lanes(const std::vector<Lane>& a, const std::vector<Lane>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const Lane& x = a[i];
+    const Lane& y = b[i];
+    if (x.id != y.id || x.subtype != y.subtype || !identical_bits(x.speed_limit_mps, y.speed_limit_mps) ||
+        !identical_points(x.left_bound, y.left_bound) || !identical_points(x.right_bound, y.right_bound) ||
+        !identical_points(x.centerline, y.centerline)) {
+      return false;
+    }
+  }
+  return true;
 }
 
 bool lanes_contain(const std::vector<Lane>& lanes, const Vec2& p) {

@@ -65,6 +65,12 @@ Polygon bounds_polygon(const Lane& lane);
 // building the world (no index, no outline). O(vertices): for one query, e.g. validation.
 bool lanes_contain(const std::vector<Lane>& lanes, const Vec2& p);
 
+// Whether two lane lists are the same bit for bit: ids, subtypes, speed limits and every
+// coordinate (compared as stored bits, so that 0.0 and -0.0 differ, as they may for atan2). The
+// LaneWorld of one is then the LaneWorld of the other: a caller may reuse a complete world built
+// for `a` where it would build one for `b`. O(points).
+bool identical_lanes(const std::vector<Lane>& a, const std::vector<Lane>& b);
+
 class LaneWorld {
  public:
   explicit LaneWorld(const std::vector<Lane>& lanes, const StopCondition& stop = {});
