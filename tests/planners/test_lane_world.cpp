@@ -45,6 +45,23 @@ TEST(IdenticalLanes, NegativeZeroIsNotZero) {
   EXPECT_FALSE(identical_lanes(lanes, other));
 }
 
+TEST(LaneWorld, AChainIsBuiltOnceAndIsTheChainOfItsLanes) {
+  // Two road lanes in a row and a shoulder beside the first.
+  const LaneWorld world({test::straight_lane(1, LaneSubtype::kRoad, 0, 50, -1.75, 1.75),
+                         test::straight_lane(2, LaneSubtype::kRoad, 50, 100, -1.75, 1.75),
+                         test::straight_lane(3, LaneSubtype::kRoadShoulder, 0, 50, 1.75, 4.75)});
+  const LaneChain& through_second = world.chain_through(1);
+  EXPECT_EQ(through_second.lanes, (std::vector<std::size_t>{0, 1}));
+  const LaneChain built = world.chain_of({0, 1});
+  EXPECT_EQ(through_second.centerline.points(), built.centerline.points());
+  EXPECT_EQ(through_second.lane_end_s, built.lane_end_s);
+  // The same chain object for the same seed; another seed has its own.
+  EXPECT_EQ(&world.chain_through(1), &through_second);
+  EXPECT_EQ(world.chain_through(0).lanes, through_second.lanes);
+  EXPECT_NE(&world.chain_through(0), &through_second);
+  EXPECT_EQ(world.chain_through(2).lanes, (std::vector<std::size_t>{2}));
+}
+
 TEST(LaneWorld, NegativeCoordinatesAreIndexed) {
   // Cells with negative indices (their hash key was once a shift of a negative number).
   const LaneWorld world({test::straight_lane(1, LaneSubtype::kRoad, -100, -50, -10, -6.5),

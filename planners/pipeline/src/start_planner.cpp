@@ -478,9 +478,10 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   // The road lanes to pull out onto: the map's pick for the route, or the chain through the road
   // lane nearest to the vehicle.
   const bool from_map = !lanes.road_ids.empty();
-  const LaneChain road = from_map
-                             ? world.chain_of(indices_of(world, lanes.road_ids))
-                             : world.chain_through(*world.nearest_lane(to_vec(request.ego_pose), LaneSubtype::kRoad));
+  LaneChain road_on_map;
+  const LaneChain& road = from_map
+                              ? (road_on_map = world.chain_of(indices_of(world, lanes.road_ids)))
+                              : world.chain_through(*world.nearest_lane(to_vec(request.ego_pose), LaneSubtype::kRoad));
 
   // Static obstacles: objects slower than th_moving_object_velocity, of the classes to check.
   // All of them are considered, wherever they stand (Autoware keeps only those overlapping the
@@ -508,8 +509,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   } else {
     for (std::size_t i : world.lanes_containing(to_vec(request.ego_pose))) {
       if (world.lanes()[i].subtype == LaneSubtype::kRoadShoulder) {
-        shoulder = world.chain_through(i);
-        pull_out = &shoulder;
+        pull_out = &world.chain_through(i);
         break;
       }
     }

@@ -46,11 +46,11 @@ SafetyMonitor::SafetyMonitor(const SafetyParameters& parameters, const VehicleIn
       objects_(std::move(objects)),
       path_(path) {
   if (const auto road = lanes_->nearest_lane(to_vec(path_.end_pose), LaneSubtype::kRoad)) {
-    current_ = lanes_->chain_through(*road);
+    current_ = &lanes_->chain_through(*road);
     if (current_->centerline.size() >= 2) {
       merging_from_left_ = current_->centerline.project(to_vec(path_.start_pose)).lateral >= 0.0;
     } else {
-      current_.reset();
+      current_ = nullptr;
     }
   }
 }

@@ -360,7 +360,11 @@ std::optional<std::size_t> LaneWorld::nearest_lane(const Vec2& p, LaneSubtype su
   return best;
 }
 
-LaneChain LaneWorld::chain_through(std::size_t seed) const {
+const LaneChain& LaneWorld::chain_through(std::size_t seed) const {
+  // Built under the lock: two threads asking for the same seed at once build it once.
+  std::lock_guard<std::mutex> lock(chains_->mutex);
+  const auto known = chains_->by_seed.find(seed);
+  if (known != chains_->by_seed.end()) return known->second;
   std::vector<std::size_t> order{seed};
   std::unordered_set<std::size_t> seen{seed};
   for (std::size_t cur = seed; !lanes_[cur].predecessors.empty();) {
@@ -375,7 +379,7 @@ LaneChain LaneWorld::chain_through(std::size_t seed) const {
     order.push_back(next);
     cur = next;
   }
-  return chain_of(order);
+  return chains_->by_seed.emplace(seed, chain_of(order)).first->second;
 }
 
 LaneChain LaneWorld::chain_of(const std::vector<std::size_t>& order) const {

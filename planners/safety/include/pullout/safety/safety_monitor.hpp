@@ -52,8 +52,8 @@ class SafetyMonitor {
   // The same on a lane world already built from those lanes (the one the path was planned on,
   // PlannedWorld::lane_world), shared instead of built again. `lanes` must not be null and must be
   // complete (not stopped).
-  SafetyMonitor(const SafetyParameters& parameters, const VehicleInfo& vehicle,
-                std::shared_ptr<const LaneWorld> lanes, std::vector<Object> objects, const PullOutPath& path);
+  SafetyMonitor(const SafetyParameters& parameters, const VehicleInfo& vehicle, std::shared_ptr<const LaneWorld> lanes,
+                std::vector<Object> objects, const PullOutPath& path);
 
   void update_objects(std::vector<Object> objects) { objects_ = std::move(objects); }
 
@@ -81,7 +81,7 @@ class SafetyMonitor {
   std::shared_ptr<const LaneWorld> lanes_;  // immutable: may be shared with the planned world
   std::vector<Object> objects_;
   PullOutPath path_;
-  std::optional<LaneChain> current_;  // the road lanes the path merges into
+  const LaneChain* current_{nullptr};  // the road lanes the path merges into (in lanes_)
   bool merging_from_left_{true};
   bool previous_safe_{true};
 };
