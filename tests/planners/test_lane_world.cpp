@@ -12,6 +12,56 @@
 namespace pullout {
 namespace {
 
+TEST(IdenticalLanes, EqualCopiesAreIdenticalAndEveryFieldCounts) {
+  const std::vector<Lane> lanes = test::straight_shoulder_request().lanes;
+  EXPECT_TRUE(identical_lanes(lanes, lanes));
+  EXPECT_TRUE(identical_lanes(std::vector<Lane>(lanes), lanes));
+  EXPECT_FALSE(identical_lanes(lanes, {lanes.front()}));
+
+  std::vector<Lane> other = lanes;
+  other[1].right_bound.back().y += 1e-9;
+  EXPECT_FALSE(identical_lanes(lanes, other));
+  other = lanes;
+  other[0].id = 7;
+  EXPECT_FALSE(identical_lanes(lanes, other));
+  other = lanes;
+  other[1].subtype = LaneSubtype::kRoad;
+  EXPECT_FALSE(identical_lanes(lanes, other));
+  other = lanes;
+  other[0].speed_limit_mps += 1.0;
+  EXPECT_FALSE(identical_lanes(lanes, other));
+  other = lanes;
+  other[0].centerline = {{0.0, 0.0}, {100.0, 0.0}};
+  EXPECT_FALSE(identical_lanes(lanes, other));
+}
+
+TEST(IdenticalLanes, NegativeZeroIsNotZero) {
+  // Equal as numbers, but atan2 tells them apart: a world built from one is not proven the other's.
+  std::vector<Lane> lanes = test::straight_shoulder_request().lanes;
+  lanes[0].left_bound.front().x = 0.0;
+  std::vector<Lane> other = lanes;
+  other[0].left_bound.front().x = -0.0;
+  ASSERT_EQ(lanes[0].left_bound.front().x, other[0].left_bound.front().x);
+  EXPECT_FALSE(identical_lanes(lanes, other));
+}
+
+TEST(LaneWorld, AChainIsBuiltOnceAndIsTheChainOfItsLanes) {
+  // Two road lanes in a row and a shoulder beside the first.
+  const LaneWorld world({test::straight_lane(1, LaneSubtype::kRoad, 0, 50, -1.75, 1.75),
+                         test::straight_lane(2, LaneSubtype::kRoad, 50, 100, -1.75, 1.75),
+                         test::straight_lane(3, LaneSubtype::kRoadShoulder, 0, 50, 1.75, 4.75)});
+  const LaneChain& through_second = world.chain_through(1);
+  EXPECT_EQ(through_second.lanes, (std::vector<std::size_t>{0, 1}));
+  const LaneChain built = world.chain_of({0, 1});
+  EXPECT_EQ(through_second.centerline.points(), built.centerline.points());
+  EXPECT_EQ(through_second.lane_end_s, built.lane_end_s);
+  // The same chain object for the same seed; another seed has its own.
+  EXPECT_EQ(&world.chain_through(1), &through_second);
+  EXPECT_EQ(world.chain_through(0).lanes, through_second.lanes);
+  EXPECT_NE(&world.chain_through(0), &through_second);
+  EXPECT_EQ(world.chain_through(2).lanes, (std::vector<std::size_t>{2}));
+}
+
 TEST(LaneWorld, NegativeCoordinatesAreIndexed) {
   // Cells with negative indices (their hash key was once a shift of a negative number).
   const LaneWorld world({test::straight_lane(1, LaneSubtype::kRoad, -100, -50, -10, -6.5),

@@ -10,6 +10,7 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/config/scenario.hpp"
+#include "pullout/lanes/lane_world.hpp"
 #include "pullout/model/names.hpp"
 #include "test_world.hpp"
 
@@ -53,6 +54,71 @@ double min_clearance(const PullOutPath& path, const std::vector<Object>& objects
     }
   }
   return best;
+}
+
+void expect_same_path(const PullOutPath& a, const PullOutPath& b) {
+  ASSERT_EQ(a.partial_paths.size(), b.partial_paths.size());
+  for (std::size_t i = 0; i < a.partial_paths.size(); ++i) {
+    const auto& pa = a.partial_paths[i].points;
+    const auto& pb = b.partial_paths[i].points;
+    ASSERT_EQ(pa.size(), pb.size());
+    for (std::size_t j = 0; j < pa.size(); ++j) {
+      EXPECT_EQ(pa[j].pose.x, pb[j].pose.x);
+      EXPECT_EQ(pa[j].pose.y, pb[j].pose.y);
+      EXPECT_EQ(pa[j].pose.yaw, pb[j].pose.yaw);
+      EXPECT_EQ(pa[j].longitudinal_velocity_mps, pb[j].longitudinal_velocity_mps);
+      EXPECT_EQ(pa[j].lane_ids, pb[j].lane_ids);
+    }
+  }
+}
+
+TEST(StartPlannerWorldReuse, TheSameLanesReuseThePreviousLaneWorldAndPlanTheSamePath) {
+  const PullOutRequest first = test::straight_shoulder_request();
+  const PlanningResult r1 = default_planner().plan(first, StopCondition());
+  ASSERT_EQ(r1.outcome, PlanningResult::Outcome::kFound) << r1.stop_reason;
+  ASSERT_TRUE(r1.world && r1.world->lane_world);
+
+  // The vehicle's next request: moved a little, the same lanes (a copy, not the same vector).
+  PullOutRequest next = first;
+  next.request_id = 2;
+  next.ego_pose.x = 12.5;
+  const PlanningResult reused = default_planner().plan(next, StopCondition(), r1.world.get());
+  const PlanningResult fresh = default_planner().plan(next, StopCondition());
+  ASSERT_EQ(reused.outcome, PlanningResult::Outcome::kFound) << reused.stop_reason;
+  ASSERT_EQ(fresh.outcome, PlanningResult::Outcome::kFound) << fresh.stop_reason;
+  EXPECT_EQ(reused.world->lane_world, r1.world->lane_world);
+  EXPECT_NE(fresh.world->lane_world, r1.world->lane_world);
+  expect_same_path(reused.path, fresh.path);
+  ASSERT_EQ(reused.evaluation_table.size(), fresh.evaluation_table.size());
+  for (std::size_t i = 0; i < reused.evaluation_table.size(); ++i) {
+    EXPECT_EQ(reused.evaluation_table[i].outcome, fresh.evaluation_table[i].outcome);
+    EXPECT_EQ(reused.evaluation_table[i].detail, fresh.evaluation_table[i].detail);
+  }
+}
+
+TEST(StartPlannerWorldReuse, OtherLanesOrAnIncompleteWorldBuildAFreshOne) {
+  const PullOutRequest first = test::straight_shoulder_request();
+  const PlanningResult r1 = default_planner().plan(first, StopCondition());
+  ASSERT_TRUE(r1.world && r1.world->lane_world);
+
+  // The shoulder 10 cm wider: another world, and the path planned on it.
+  PullOutRequest wider = first;
+  wider.lanes[1].right_bound.front().y += 0.1;
+  wider.lanes[1].right_bound.back().y += 0.1;
+  const PlanningResult r2 = default_planner().plan(wider, StopCondition(), r1.world.get());
+  ASSERT_TRUE(r2.world && r2.world->lane_world);
+  EXPECT_NE(r2.world->lane_world, r1.world->lane_world);
+  EXPECT_EQ(r2.world->lane_world->lanes()[1].polygon, LaneWorld(wider.lanes).lanes()[1].polygon);
+
+  // A build cut short keeps no lane world to offer.
+  std::atomic<bool> cancel{true};
+  const PlanningResult stopped = default_planner().plan(first, StopCondition().with_cancel(&cancel));
+  ASSERT_EQ(stopped.stopped, StopReason::kCancelled);
+  ASSERT_TRUE(stopped.world);
+  EXPECT_EQ(stopped.world->lane_world, nullptr);
+  const PlanningResult after = default_planner().plan(first, StopCondition(), stopped.world.get());
+  ASSERT_EQ(after.outcome, PlanningResult::Outcome::kFound) << after.stop_reason;
+  EXPECT_NE(after.world->lane_world, nullptr);
 }
 
 TEST(StartPlanner, ParkedCarAheadForcesASmallerMargin) {

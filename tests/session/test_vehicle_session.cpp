@@ -92,6 +92,37 @@ TEST_F(Session, AValidRequestOrdersASearchAndSaysPlanning) {
   EXPECT_EQ(e.search->sequence, session_->pending_search());
 }
 
+TEST_F(Session, TheNextSearchIsOfferedThePreviousWorldAndARejectionDropsIt) {
+  // The first search has nothing to reuse.
+  SessionEffects e = session_->on_request(test::straight_shoulder_request(), {}, now_);
+  ASSERT_TRUE(e.search);
+  EXPECT_EQ(e.search->previous_world, nullptr);
+  const PlanningResult r1 = planner_->plan(e.search->request, StopCondition());
+  ASSERT_TRUE(r1.world && r1.world->lane_world);
+  session_->on_result(e.search->sequence, r1, now_);
+  ASSERT_EQ(status().state, ExecutionState::kWaitingApproval);
+
+  // A new goal: a new search, offered the world the path was planned on.
+  PullOutRequest next = test::straight_shoulder_request();
+  next.request_id = 2;
+  next.goal_pose.x = 80.0;
+  now_ += seconds(1);
+  e = session_->on_request(next, {}, now_);
+  ASSERT_TRUE(e.search);
+  EXPECT_EQ(e.search->previous_world, r1.world);
+
+  // Rejected: nothing of the earlier requests is kept, nor offered to the one after.
+  PullOutRequest bad = next;
+  bad.request_id = 3;
+  bad.ego_pose.x = std::numeric_limits<double>::quiet_NaN();
+  e = session_->on_request(bad, {}, now_);
+  ASSERT_EQ(status().state, ExecutionState::kRejected);
+  next.request_id = 4;
+  e = session_->on_request(next, {}, now_);
+  ASSERT_TRUE(e.search);
+  EXPECT_EQ(e.search->previous_world, nullptr);
+}
+
 TEST_F(Session, AnInvalidRequestIsRejectedWithTheFieldAndNoSearch) {
   PullOutRequest r = test::straight_shoulder_request();
   r.ego_pose.x = std::numeric_limits<double>::quiet_NaN();

@@ -346,14 +346,14 @@ std::shared_ptr<const PlannedWorld> StartPlanner::planned_world(const PullOutReq
   if (!issues.empty()) return nullptr;
   const VehicleInfo vehicle = vehicle_for(request);
   if (request.lanes.empty() && !has_route(request)) {  // a grid-only request: no lanes (as plan())
-    return std::make_shared<const PlannedWorld>(PlannedWorld{{}, request.objects, vehicle});
+    return std::make_shared<const PlannedWorld>(PlannedWorld{{}, request.objects, vehicle, nullptr});
   }
   RequestLanes lanes = request_lanes(request, map_.get(), vehicle, parameters_, limits_);
   if (!lanes.issues.empty()) {
     issues = std::move(lanes.issues);
     return nullptr;
   }
-  return std::make_shared<const PlannedWorld>(PlannedWorld{std::move(lanes.lanes), request.objects, vehicle});
+  return std::make_shared<const PlannedWorld>(PlannedWorld{std::move(lanes.lanes), request.objects, vehicle, nullptr});
 }
 
 bool StartPlanner::grid_only_allowed() const { return parameters_.freespace_planner.enable_freespace_planner; }
@@ -400,14 +400,17 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
   return result;
 }
 
-PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondition& stop) const {
+PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondition& stop,
+                                  const PlannedWorld* previous) const {
   const auto t0 = std::chrono::steady_clock::now();
   PlanningResult result;
   const std::vector<Lane>* planned_lanes = nullptr;  // the lanes planned on, once known
+  std::shared_ptr<const LaneWorld> lane_world;       // built from them, once complete
   const auto finish = [&](PlanningResult& r) {
     if (r.outcome != PlanningResult::Outcome::kRejected) {
-      r.world = std::make_shared<const PlannedWorld>(PlannedWorld{
-          planned_lanes != nullptr ? *planned_lanes : std::vector<Lane>{}, request.objects, vehicle_for(request)});
+      r.world = std::make_shared<const PlannedWorld>(
+          PlannedWorld{planned_lanes != nullptr ? *planned_lanes : std::vector<Lane>{}, request.objects,
+                       vehicle_for(request), lane_world});
     }
     r.planning_time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     r.path.vehicle_id = request.vehicle_id;
@@ -451,8 +454,15 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
     return result;
   }
   planned_lanes = &lanes.lanes;
-  const LaneWorld world(lanes.lanes, stop);
+  // The previous world's, when its lanes are these (identical_lanes: the build is a function of
+  // the lanes alone, so it would build the same world). A stopped build is never kept.
+  std::shared_ptr<const LaneWorld> built =
+      previous != nullptr && previous->lane_world && identical_lanes(previous->lanes, lanes.lanes)
+          ? previous->lane_world
+          : std::make_shared<const LaneWorld>(lanes.lanes, stop);
+  const LaneWorld& world = *built;
   if (world.stopped() != StopReason::kNone) return stopped_early(result, world.stopped());
+  lane_world = std::move(built);
   if (auto issue =
           check_start_on_lanes(lanes.lanes, world.contains(to_vec(request.ego_pose)), request.ego_pose, vehicle)) {
     result.issues.push_back(*issue);
@@ -468,9 +478,10 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   // The road lanes to pull out onto: the map's pick for the route, or the chain through the road
   // lane nearest to the vehicle.
   const bool from_map = !lanes.road_ids.empty();
-  const LaneChain road = from_map
-                             ? world.chain_of(indices_of(world, lanes.road_ids))
-                             : world.chain_through(*world.nearest_lane(to_vec(request.ego_pose), LaneSubtype::kRoad));
+  LaneChain road_on_map;
+  const LaneChain& road = from_map
+                              ? (road_on_map = world.chain_of(indices_of(world, lanes.road_ids)))
+                              : world.chain_through(*world.nearest_lane(to_vec(request.ego_pose), LaneSubtype::kRoad));
 
   // Static obstacles: objects slower than th_moving_object_velocity, of the classes to check.
   // All of them are considered, wherever they stand (Autoware keeps only those overlapping the
@@ -498,8 +509,7 @@ PlanningResult StartPlanner::plan(const PullOutRequest& request, const StopCondi
   } else {
     for (std::size_t i : world.lanes_containing(to_vec(request.ego_pose))) {
       if (world.lanes()[i].subtype == LaneSubtype::kRoadShoulder) {
-        shoulder = world.chain_through(i);
-        pull_out = &shoulder;
+        pull_out = &world.chain_through(i);
         break;
       }
     }

@@ -35,24 +35,29 @@ double max_speed(const PathWithLaneId& segment) {
 
 SafetyMonitor::SafetyMonitor(const SafetyParameters& parameters, const VehicleInfo& vehicle,
                              const std::vector<Lane>& lanes, std::vector<Object> objects, const PullOutPath& path)
+    : SafetyMonitor(parameters, vehicle, std::make_shared<const LaneWorld>(lanes), std::move(objects), path) {}
+
+SafetyMonitor::SafetyMonitor(const SafetyParameters& parameters, const VehicleInfo& vehicle,
+                             std::shared_ptr<const LaneWorld> lanes, std::vector<Object> objects,
+                             const PullOutPath& path)
     : parameters_(parameters),
       footprint_(vehicle_footprint(vehicle)),
-      lanes_(lanes),
+      lanes_(std::move(lanes)),
       objects_(std::move(objects)),
       path_(path) {
-  if (const auto road = lanes_.nearest_lane(to_vec(path_.end_pose), LaneSubtype::kRoad)) {
-    current_ = lanes_.chain_through(*road);
+  if (const auto road = lanes_->nearest_lane(to_vec(path_.end_pose), LaneSubtype::kRoad)) {
+    current_ = &lanes_->chain_through(*road);
     if (current_->centerline.size() >= 2) {
       merging_from_left_ = current_->centerline.project(to_vec(path_.start_pose)).lateral >= 0.0;
     } else {
-      current_.reset();
+      current_ = nullptr;
     }
   }
 }
 
 SafetyMonitor::Gaps SafetyMonitor::gaps(const Vec2& p) const {
   const LaneChain& chain = *current_;
-  const LaneGeometry& lane = lanes_.lanes()[chain.lanes[chain.lane_at(chain.centerline.project(p).s)]];
+  const LaneGeometry& lane = lanes_->lanes()[chain.lanes[chain.lane_at(chain.centerline.project(p).s)]];
   // Lateral offsets are left-positive; inside the lane: left of the right bound, right of the left.
   const double from_right = lane.right.size() >= 2 ? lane.right.project(p).lateral : 0.0;
   const double from_left = lane.left.size() >= 2 ? -lane.left.project(p).lateral : 0.0;
@@ -69,8 +74,8 @@ std::vector<Object> SafetyMonitor::targets(const Pose2& ego) const {
     if (std::abs(o.velocity_mps) <= f.ignore_object_velocity_threshold) continue;
     const Vec2 p = to_vec(o.pose);
     bool on_lane = false;
-    for (const std::size_t i : lanes_.lanes_containing(p)) {
-      const LaneGeometry& lane = lanes_.lanes()[i];
+    for (const std::size_t i : lanes_->lanes_containing(p)) {
+      const LaneGeometry& lane = lanes_->lanes()[i];
       if (lane.subtype == LaneSubtype::kRoadShoulder && f.check_shoulder_lane) on_lane = true;
       if (lane.subtype == LaneSubtype::kRoad && f.check_current_lane && current_ &&
           std::find(current_->lanes.begin(), current_->lanes.end(), i) != current_->lanes.end()) {
@@ -111,7 +116,7 @@ bool SafetyMonitor::preventing_rear_vehicle(const std::vector<Pose2>& poses) con
     for (const Object& o : candidates) {
       const Vec2 p = to_vec(o.pose);
       bool on_current = false;
-      for (const std::size_t i : lanes_.lanes_containing(p)) {
+      for (const std::size_t i : lanes_->lanes_containing(p)) {
         on_current |= std::find(current_->lanes.begin(), current_->lanes.end(), i) != current_->lanes.end();
       }
       const double behind = s_ego - current_->centerline.project(p).s;

@@ -88,6 +88,7 @@ void VehicleSession::supersede() {
 SessionEffects VehicleSession::reject(std::uint64_t request_id, const std::vector<RequestIssue>& issues) {
   supersede();
   objects_ = std::vector<Object>{};  // clear() would keep the capacity
+  last_world_.reset();
   SessionEffects out;
   out.cancel_search = true;
   PullOutPath path;
@@ -168,7 +169,7 @@ SessionEffects VehicleSession::on_request(PullOutRequest request, const std::vec
   SessionEffects out;
   out.status = status_;
   out.cancel_search = true;
-  out.search = SearchOrder{sequence_, std::move(request)};
+  out.search = SearchOrder{sequence_, std::move(request), last_world_};
   return out;
 }
 
@@ -177,6 +178,7 @@ SessionEffects VehicleSession::on_result(std::uint64_t sequence, const PlanningR
   if (sequence == 0 || sequence != pending_) return out;  // a newer request came meanwhile
   pending_ = 0;
   const std::uint64_t request_id = status_.request_id;
+  if (result.world && result.world->lane_world) last_world_ = result.world;
 
   PullOutStatus status = make_status(request_id, ExecutionState::kNoPath);
   status.evaluation_table = result.evaluation_table;
@@ -224,7 +226,12 @@ SessionEffects VehicleSession::on_result(std::uint64_t sequence, const PlanningR
       path_ = path;
       published_ = path;
       planned_vehicle_ = result.world->vehicle;
-      safety_.emplace(planner_.parameters(), planned_vehicle_, result.world->lanes, objects_, path);
+      // The lane world the path was planned on, shared rather than built again.
+      if (result.world->lane_world) {
+        safety_.emplace(planner_.parameters(), planned_vehicle_, result.world->lane_world, objects_, path);
+      } else {
+        safety_.emplace(planner_.parameters(), planned_vehicle_, result.world->lanes, objects_, path);
+      }
       if (signal_carry_ && signal_carry_->signal == path.turn_signal) {
         status.turn_signal_start_ns = signal_carry_->stamp_ns;
         signal_on_at_ = signal_carry_->at;

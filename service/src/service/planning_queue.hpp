@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "pullout/model/types.hpp"
+#include "pullout/pipeline/start_planner.hpp"
 
 namespace pullout::service {
 
@@ -32,6 +33,9 @@ struct PlanningJob {
   // StopCondition watches it.
   std::shared_ptr<std::atomic<bool>> cancel;
   std::chrono::steady_clock::time_point accepted_at;
+  // The vehicle's previous world (SearchOrder::previous_world): StartPlanner::plan reuses its lane
+  // world when the lanes are identical.
+  std::shared_ptr<const PlannedWorld> previous_world;
 };
 
 class PlanningQueue {

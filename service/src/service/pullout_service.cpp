@@ -515,7 +515,7 @@ void PulloutService::run_job(PlanningJob& job) {
 
   PlanningResult result;
   try {
-    result = planner_.plan(request, stop);
+    result = planner_.plan(request, stop, job.previous_world.get());
   } catch (const std::exception& e) {
     spdlog::error("vehicle '{}' request {}: planner failed: {}", request.vehicle_id, request.request_id, e.what());
     if (!stopping_) registry_.on_search_failed(job, e.what());

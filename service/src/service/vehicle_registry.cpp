@@ -223,6 +223,7 @@ std::optional<PlanningJob> VehicleRegistry::settle(Slot& slot, std::unique_lock<
     job->cancel = slot.cancel;
     job->accepted_at = Clock::now();
     job->request = std::move(effects.search->request);
+    job->previous_world = std::move(effects.search->previous_world);
   }
   if (!effects.note.empty()) spdlog::debug("vehicle '{}': {}", vehicle_id, effects.note);
   if (!effects.path && !effects.status) return job;

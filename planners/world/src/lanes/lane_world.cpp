@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <unordered_set>
 
 namespace pullout {
@@ -162,6 +163,34 @@ Polygon bounds_polygon(const Lane& lane) {
   const Polyline right(to_vecs(lane.right_bound));
   polygon.insert(polygon.end(), right.points().rbegin(), right.points().rend());
   return polygon;
+}
+
+namespace {
+
+bool identical_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+bool identical_points(const std::vector<Point2>& a, const std::vector<Point2>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!identical_bits(a[i].x, b[i].x) || !identical_bits(a[i].y, b[i].y)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool identical_lanes(const std::vector<Lane>& a, const std::vector<Lane>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const Lane& x = a[i];
+    const Lane& y = b[i];
+    if (x.id != y.id || x.subtype != y.subtype || !identical_bits(x.speed_limit_mps, y.speed_limit_mps) ||
+        !identical_points(x.left_bound, y.left_bound) || !identical_points(x.right_bound, y.right_bound) ||
+        !identical_points(x.centerline, y.centerline)) {
+      return false;
+    }
+  }
+  return true;
 }
 
 bool lanes_contain(const std::vector<Lane>& lanes, const Vec2& p) {
@@ -331,7 +360,11 @@ std::optional<std::size_t> LaneWorld::nearest_lane(const Vec2& p, LaneSubtype su
   return best;
 }
 
-LaneChain LaneWorld::chain_through(std::size_t seed) const {
+const LaneChain& LaneWorld::chain_through(std::size_t seed) const {
+  // Built under the lock: two threads asking for the same seed at once build it once.
+  std::lock_guard<std::mutex> lock(chains_->mutex);
+  const auto known = chains_->by_seed.find(seed);
+  if (known != chains_->by_seed.end()) return known->second;
   std::vector<std::size_t> order{seed};
   std::unordered_set<std::size_t> seen{seed};
   for (std::size_t cur = seed; !lanes_[cur].predecessors.empty();) {
@@ -346,7 +379,7 @@ LaneChain LaneWorld::chain_through(std::size_t seed) const {
     order.push_back(next);
     cur = next;
   }
-  return chain_of(order);
+  return chains_->by_seed.emplace(seed, chain_of(order)).first->second;
 }
 
 LaneChain LaneWorld::chain_of(const std::vector<std::size_t>& order) const {

@@ -52,6 +52,7 @@
 namespace pullout {
 
 class LaneletMap;
+class LaneWorld;
 
 // "field: problem" lines joined by '\n'.
 std::string format_issues(const std::vector<RequestIssue>& issues);
@@ -62,6 +63,10 @@ struct PlannedWorld {
   std::vector<Lane> lanes;
   std::vector<Object> objects;
   VehicleInfo vehicle;  // the vehicle planned for (StartPlanner::vehicle_for)
+  // The complete lane world plan() built from `lanes` (or reused, see plan()); null when it built
+  // none (a grid-only request, a build cut short, planned_world()). Immutable, so the safety
+  // monitor of a found path and a later request's search may share it across threads.
+  std::shared_ptr<const LaneWorld> lane_world;
 };
 
 struct PlanningResult {
@@ -112,7 +117,12 @@ class StartPlanner {
   // Plans for one request within `stop` (checked before every attempt and inside every search).
   // Applies the request's overrides (search_priority, search_policy) to a copy of the parameters.
   // Never throws for bad input.
-  PlanningResult plan(const PullOutRequest& request, const StopCondition& stop) const;
+  // `previous`: a world an earlier plan() returned (the vehicle's previous request), or null. When
+  // this request's lanes, after cropping, are bit for bit that world's lanes (identical_lanes), its
+  // lane world is used instead of building the same one again: the result is the same, only the
+  // build's time is saved (a vehicle re-sending its request with new poses and the same lanes).
+  PlanningResult plan(const PullOutRequest& request, const StopCondition& stop,
+                      const PlannedWorld* previous = nullptr) const;
 
   // Only the validation step of plan(): every problem of the request, empty when valid.
   std::vector<RequestIssue> validate(const PullOutRequest& request) const;

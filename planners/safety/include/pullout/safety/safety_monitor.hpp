@@ -23,6 +23,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,11 @@ class SafetyMonitor {
   // `path` must be a found path; `lanes` and `objects` from its request.
   SafetyMonitor(const SafetyParameters& parameters, const VehicleInfo& vehicle, const std::vector<Lane>& lanes,
                 std::vector<Object> objects, const PullOutPath& path);
+  // The same on a lane world already built from those lanes (the one the path was planned on,
+  // PlannedWorld::lane_world), shared instead of built again. `lanes` must not be null and must be
+  // complete (not stopped).
+  SafetyMonitor(const SafetyParameters& parameters, const VehicleInfo& vehicle, std::shared_ptr<const LaneWorld> lanes,
+                std::vector<Object> objects, const PullOutPath& path);
 
   void update_objects(std::vector<Object> objects) { objects_ = std::move(objects); }
 
@@ -72,10 +78,10 @@ class SafetyMonitor {
 
   SafetyParameters parameters_;
   Footprint footprint_;
-  LaneWorld lanes_;
+  std::shared_ptr<const LaneWorld> lanes_;  // immutable: may be shared with the planned world
   std::vector<Object> objects_;
   PullOutPath path_;
-  std::optional<LaneChain> current_;  // the road lanes the path merges into
+  const LaneChain* current_{nullptr};  // the road lanes the path merges into (in lanes_)
   bool merging_from_left_{true};
   bool previous_safe_{true};
 };

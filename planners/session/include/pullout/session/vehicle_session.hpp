@@ -90,6 +90,9 @@ inline constexpr int kReanchorSamples = 5;
 struct SearchOrder {
   std::uint64_t sequence{0};
   PullOutRequest request;
+  // The world of the vehicle's previous search, for StartPlanner::plan's `previous` (it reuses the
+  // lane world when the lanes are identical); null when there is none.
+  std::shared_ptr<const PlannedWorld> previous_world;
 };
 
 struct SessionEffects {
@@ -208,6 +211,11 @@ class VehicleSession {
   double request_ego_velocity_{0.0};
   Clock::time_point planned_at_{};
   std::vector<Object> objects_;  // the latest objects (re-sent requests replace them)
+  // The world of the latest search's result that has a lane world (kFound or kNoPath), handed to
+  // the next search (SearchOrder::previous_world) so that a request with the same lanes does not
+  // build the same lane world again. Only for that reuse, never for safety (safety_ has its own
+  // reference). Dropped when a request is rejected.
+  std::shared_ptr<const PlannedWorld> last_world_;
 
   // The found path being followed (as planned), its safety monitor and what was published of it.
   std::optional<PullOutPath> path_;

@@ -14,7 +14,10 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "pullout/geometry/grid_index.hpp"
@@ -65,6 +68,12 @@ Polygon bounds_polygon(const Lane& lane);
 // building the world (no index, no outline). O(vertices): for one query, e.g. validation.
 bool lanes_contain(const std::vector<Lane>& lanes, const Vec2& p);
 
+// Whether two lane lists are the same bit for bit: ids, subtypes, speed limits and every
+// coordinate (compared as stored bits, so that 0.0 and -0.0 differ, as they may for atan2). The
+// LaneWorld of one is then the LaneWorld of the other: a caller may reuse a complete world built
+// for `a` where it would build one for `b`. O(points).
+bool identical_lanes(const std::vector<Lane>& a, const std::vector<Lane>& b);
+
 class LaneWorld {
  public:
   explicit LaneWorld(const std::vector<Lane>& lanes, const StopCondition& stop = {});
@@ -89,8 +98,10 @@ class LaneWorld {
   std::optional<std::size_t> nearest_lane(const Vec2& p, LaneSubtype subtype) const;
 
   // The chain of lanes through `seed`, following predecessors back and successors forward (the
-  // first one when there are several), without cycles.
-  LaneChain chain_through(std::size_t seed) const;
+  // first one when there are several), without cycles. Built on the first call for a seed and
+  // kept: the reference lives as long as the world (a world reused for a vehicle's next request,
+  // and shared with its safety monitor, builds each chain once). Thread-safe.
+  const LaneChain& chain_through(std::size_t seed) const;
   // The chain of the given lanes in the given order (indices into lanes(); expected to be
   // connected, e.g. a route on a map).
   LaneChain chain_of(const std::vector<std::size_t>& order) const;
@@ -128,6 +139,12 @@ class LaneWorld {
   bool any_piece_containing(const Vec2& p, std::size_t skip_lane, F&& accept, std::size_t* edge_tests = nullptr) const;
   // Indices into outer_edges_, by the cells their boxes cover.
   GridIndex<std::uint32_t> edge_index_{kCellSize};
+  // chain_through's chains by seed (node-based: references stay valid as it grows).
+  struct ChainMemo {
+    std::mutex mutex;
+    std::unordered_map<std::size_t, LaneChain> by_seed;
+  };
+  std::unique_ptr<ChainMemo> chains_ = std::make_unique<ChainMemo>();
 };
 
 }  // namespace pullout
