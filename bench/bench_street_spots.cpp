@@ -97,7 +97,9 @@ int direction_changes(const PullOutPath& path) {
 
 int main(int argc, char** argv) {
   // --why: the evaluation table's last row of every spot the shunting planner leaves unsolved.
-  const bool why = argc > 1 && std::string(argv[1]) == "--why";
+  // --shunts: as --why, with the shunting planner alone (a quick run while working on it).
+  const bool shunts_only = argc > 1 && std::string(argv[1]) == "--shunts";
+  const bool why = shunts_only || (argc > 1 && std::string(argv[1]) == "--why");
   // --spots: one line per spot for the shipped search (time, thread CPU time, outcome, its
   // evaluation table's freespace rows).
   // --one right|left LANES RADIUS KERB SLACK: that spot alone, shipped search, with --spots' line.
@@ -143,6 +145,7 @@ int main(int argc, char** argv) {
             const Street st = street::make_street(sp, v);
             for (const Planner& pl : planners) {
               if (spots && std::string(pl.name) != "default search") continue;
+              if (shunts_only && std::string(pl.name) != "geometric with shunts") continue;
               const StartPlanner planner(v, pl.params);
               const double cpu0 = thread_cpu_ms();
               const auto t0 = std::chrono::steady_clock::now();

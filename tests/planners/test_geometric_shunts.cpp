@@ -173,6 +173,35 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   EXPECT_GE(most_changes, 3);
 }
 
+// One road lane (a one-way street: no opposite lane to swing into), straight, 0.3 and 0.5 m from
+// the kerb, 1.2 to 3.0 m of slack: every spot is left, every path passes the oracles. After the
+// shunts the vehicle stands turned across the single lane, and two turns at R_min (5.06 m) swing
+// its front corner on the road side over the far edge while it straightens (by up to
+// hypot(R + w, front) - (R + w) = 1.1 m); the exit at a gentler curvature fits the lane's width.
+// Without those exits 8 of these 16 spots (1.2-2.0 m of slack) had no path.
+TEST(GeometricShunts, LeavesSingleLaneSpotsWithAGentlerExit) {
+  const VehicleInfo v;
+  const StartPlannerParameters p = shipped_without_freespace();
+  const StartPlanner planner(v, p);
+  const double margin = smallest_margin(p);
+  int spots = 0;
+  for (bool right_hand : {true, false}) {
+    for (double kerb : {0.3, 0.5}) {
+      for (double slack : {3.0, 2.0, 1.5, 1.2}) {
+        const Spot s{right_hand, 1, kerb, slack};
+        const Street st = make_spot(s, v);
+        const PlanningResult r = planner.plan(st.request, StopCondition());
+        ++spots;
+        EXPECT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
+        if (r.outcome != PlanningResult::Outcome::kFound) continue;
+        const std::string verdict = check_path(r.path, st, v, margin);
+        EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
+      }
+    }
+  }
+  EXPECT_EQ(spots, 16);
+}
+
 // The generator (street_spots.hpp) on bends: the body is `kerb` from the kerb polyline at its
 // closest point and inside the raw lane polygons, and the cars are slack / 2 from it. Before, a
 // car tangent to a 30 m bend at its rear axle, "0.15 m" from the outer kerb there, overlapped the

@@ -58,8 +58,10 @@
 //      ahead (or after turning by 22.5 degrees), then reverse at full lock the other way until
 //      just clear of what is behind (where the rear corner meets the kerb at once: straight back):
 //      both turn the vehicle further towards the road; back to 1, at most
-//      geometric_pull_out_max_shunts times. From a turned pose, two turns at R_min joined by a
-//      0..9 m tangent are tried after the S (a counter-arc onto the lane).
+//      geometric_pull_out_max_shunts times. From a turned pose, two turns joined by a 0..9 m
+//      tangent are tried after the S (a counter-arc onto the lane), at R_min, then at 2 and 3.3
+//      R_min: straightening from a pose turned across a single road lane at R_min swings the
+//      front corner on the road side over the far edge.
 // "Just clear": every pose of a move keeps the footprint (expanded by
 // lane_departure_check_expansion_margin, and 1 cm) inside the lanes and at least the smallest
 // collision margin plus 2 cm from every static obstacle (sampled every 2 cm at most and bisected
