@@ -170,6 +170,18 @@ int main(int argc, char** argv) {
                 std::printf("spot: %s kerb %.2f slack %.1f: %s %s %.1f ms (cpu %.1f ms)%s\n", family.c_str(), kerb,
                             slack, ok ? "solved" : "unsolved", ok ? to_string(r.path.planner_type) : "-", ms, cpu,
                             rows.c_str());
+                // --one: the path's partial paths (direction, length, heading from and to, start).
+                for (std::size_t k = 0; one && ok && k < r.path.partial_paths.size(); ++k) {
+                  const auto& pts = r.path.partial_paths[k].points;
+                  double len = 0.0;
+                  for (std::size_t i = 1; i < pts.size(); ++i) {
+                    len += std::hypot(pts[i].pose.x - pts[i - 1].pose.x, pts[i].pose.y - pts[i - 1].pose.y);
+                  }
+                  std::printf("  partial path %zu: %s %.2f m, yaw %.1f -> %.1f deg, from (%.2f, %.2f)\n", k,
+                              oracle::direction_of(r.path.partial_paths[k]) > 0.0 ? "forward" : "reverse", len,
+                              pts.front().pose.yaw * 180.0 / M_PI, pts.back().pose.yaw * 180.0 / M_PI,
+                              pts.front().pose.x, pts.front().pose.y);
+                }
               }
               if (why && !ok && std::string(pl.name) == "geometric with shunts" && !r.evaluation_table.empty()) {
                 std::printf("unsolved: %s kerb %.2f slack %.1f: %s\n", family.c_str(), kerb, slack,
