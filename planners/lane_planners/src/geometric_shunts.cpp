@@ -33,14 +33,17 @@ constexpr double kLaneSlack = 0.01;  // [m] footprint growth of the moves' lane 
 constexpr double kMaxMoveTurn = kPi / 8.0;
 constexpr double kMaxTilt = kPi / 2.0;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-constexpr double kOutputInterval = 0.1;
+constexpr double kOutputInterval = 0.1;  // [m] points of a move: chords within 0.3 mm of a 5 m arc
 // [m] Creeping away from the kerb (see plan_multi_move) goes on until the lane check's footprint
 // has this much room on the kerb side (where the shunts get out from: every spot 0.3 m from the
 // kerb with 1.0 m of slack or more and two road lanes is left), at most kMaxCreeps times, while
 // each gains kMinCreep or more.
 constexpr double kCreepTarget = 0.3;
+// [m] The second try's target, where creeping to kCreepTarget was not enough or shunting got stuck
+// otherwise (turned across a single road lane: from further out less turn passes the car ahead).
+constexpr double kCreepFar = 0.6;
 constexpr int kMaxCreeps = 8;
-constexpr double kMinCreep = 0.01;  // [m] points of a move: chords within 0.3 mm of a 5 m arc
+constexpr double kMinCreep = 0.01;
 
 struct Move {
   Pose2 from;
@@ -212,15 +215,16 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
     return true;
   };
   // The room [m] beside the kerb side of lane_fp at q, up to kCreepTarget (bisection).
+  double creep_target = 0.0;  // [m] 0: no creeping
   const auto kerb_room = [&](const Pose2& q) {
     const auto inside = [&](double e) {
       Footprint f = lane_fp;
       f.*kerb_side += e;
       return ctx.world.footprint_inside(footprint_corners(f, q));
     };
-    if (inside(kCreepTarget)) return kCreepTarget;
+    if (inside(creep_target)) return creep_target;
     double lo = 0.0;
-    double hi = kCreepTarget;
+    double hi = creep_target;
     for (int i = 0; i < kEndBisections; ++i) {
       const double mid = 0.5 * (lo + hi);
       (inside(mid) ? lo : hi) = mid;
@@ -232,7 +236,8 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
   std::string stuck;
   // The manoeuvre; with `creep`, first edge away from the kerb (see kCreepTarget). False when it
   // got stuck (`stuck` says where).
-  const auto manoeuvre = [&](bool creep) {
+  const auto manoeuvre = [&](double target) {
+    creep_target = target;
     moves.clear();
     pose = start;
     exit.reset();
@@ -243,11 +248,11 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
     // ends beside where it was, 2 R (1 - cos(L / 2R)) further from the kerb for L [m] of room (3 cm
     // at 0.76 m, 8 cm at 1.26 m). The rear corner on the kerb side dips by about rear x L / 2R on
     // the way and is back above its start at the end.
-    for (int c = 0; creep && c < kMaxCreeps && kerb_room(pose) < kCreepTarget; ++c) {
+    for (int c = 0; target > 0.0 && c < kMaxCreeps && kerb_room(pose) < target; ++c) {
       const double before = kerb_room(pose);
       const std::size_t kept = moves.size();
       const Pose2 kept_pose = pose;
-      const MoveLimit ahead = drive_until_clear(ctx, pose, 0.0, 1.0, 2.0 * kCreepTarget + 2.0, lane_fp, limit);
+      const MoveLimit ahead = drive_until_clear(ctx, pose, 0.0, 1.0, 2.0 * target + 2.0, lane_fp, limit);
       const double yaw0 = pose.yaw;
       bool ok = ahead.length >= 2.0 * kMinCreep && add(side * kappa, 1.0, 0.5 * ahead.length);
       ok = ok && add(-side * kappa, 1.0, std::abs(normalize_angle(pose.yaw - yaw0)) / kappa);
@@ -299,12 +304,20 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
     return exit.has_value();
   };
   // Where the reverse moves have taken the rear corner to the kerb, again after creeping away
-  // from it (a car parked 0.15 m from the kerb).
-  const bool left = manoeuvre(false);
+  // from it (a car parked 0.15 m from the kerb); where that or the first try got stuck otherwise,
+  // again after creeping further.
+  bool left = manoeuvre(0.0);
   if (out.stopped != StopReason::kNone) return out;
   if (!left && stuck.rfind("no room to reverse", 0) == 0) {
     const std::string first = stuck;
-    if (!manoeuvre(true)) stuck = first + "; after creeping away from the kerb: " + stuck;
+    left = manoeuvre(kCreepTarget);
+    if (!left) stuck = first + "; after creeping away from the kerb: " + stuck;
+    if (out.stopped != StopReason::kNone) return out;
+  }
+  if (!left) {
+    const std::string first = stuck;
+    left = manoeuvre(kCreepFar);
+    if (!left) stuck = first + "; after creeping further: " + stuck;
     if (out.stopped != StopReason::kNone) return out;
   }
   if (!exit) return fail(AttemptOutcome::kNoGeometry, stuck);
