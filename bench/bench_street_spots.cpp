@@ -99,6 +99,9 @@ int main(int argc, char** argv) {
   // --why: the evaluation table's last row of every spot the shunting planner leaves unsolved.
   // --shunts: as --why, with the shunting planner alone (a quick run while working on it).
   const bool shunts_only = argc > 1 && std::string(argv[1]) == "--shunts";
+  // PULLOUT_BENCH_CPU=1: the tables' times are this thread's CPU time, not wall-clock time (on a
+  // machine loaded by other work).
+  const bool cpu_times = std::getenv("PULLOUT_BENCH_CPU") != nullptr;
   const bool why = shunts_only || (argc > 1 && std::string(argv[1]) == "--why");
   // --spots: one line per spot for the shipped search (time, thread CPU time, outcome, its
   // evaluation table's freespace rows).
@@ -189,7 +192,7 @@ int main(int argc, char** argv) {
               }
               for (Tally* t : {&by_family[family][pl.name], &by_slack[pl.name][slack]}) {
                 ++t->total;
-                t->ms.push_back(ms);
+                t->ms.push_back(cpu_times ? cpu : ms);
                 if (ok) {
                   ++t->solved;
                   t->cusps += direction_changes(r.path);
@@ -208,7 +211,8 @@ int main(int argc, char** argv) {
   }
   double load[3] = {0, 0, 0};
   if (::getloadavg(load, 3) != 3) load[0] = -1;
-  std::printf("load average %.2f %.2f %.2f\n\n", load[0], load[1], load[2]);
+  std::printf("load average %.2f %.2f %.2f; times: %s\n\n", load[0], load[1], load[2],
+              cpu_times ? "thread CPU" : "wall clock");
   const auto mean = [](int sum, int n) { return n ? static_cast<double>(sum) / n : 0.0; };
   const auto found_by = [](const Tally& t) {
     std::string out;

@@ -267,18 +267,27 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
       out.stopped = stop.check();
       if (out.stopped != StopReason::kNone) return false;
       // 1. The S from here.
-      std::vector<CurvaturePath> turn_paths;
-      PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, kInfinity, &turn_paths, moves.size() > 1);
-      for (std::size_t i = 0; i < s.candidates.size(); ++i) {
-        PathCandidate& c = s.candidates[i];
-        if (c.rejection || c.clearance < ctx.smallest_margin) continue;
-        // The S's own clearance samples every 0.5 m and refines around minima; from a tilted start
-        // the corners pass the cars within centimetres of the start, so it is taken densely here.
-        const CurvaturePath& turns = turn_paths[i];
-        const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kDenseSlack);
-        if (dense.distance < ctx.smallest_margin + kDenseSlack) continue;
-        exit = std::move(c);
-        break;
+      // The candidates in order up to the first usable one (the rest are not needed when its dense
+      // check passes); all of them only where it does not: the same exit as taking all at once.
+      for (const double usable : {ctx.smallest_margin, kInfinity}) {
+        std::vector<CurvaturePath> turn_paths;
+        PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, usable, &turn_paths, moves.size() > 1);
+        bool usable_found = false;
+        for (std::size_t i = 0; i < s.candidates.size(); ++i) {
+          PathCandidate& c = s.candidates[i];
+          if (c.rejection || c.clearance < ctx.smallest_margin) continue;
+          usable_found = true;
+          // The S's own clearance samples every 0.5 m and refines around minima; from a tilted
+          // start the corners pass the cars within centimetres of the start, so it is taken
+          // densely here.
+          const CurvaturePath& turns = turn_paths[i];
+          const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kDenseSlack);
+          if (dense.distance < ctx.smallest_margin + kDenseSlack) continue;
+          exit = std::move(c);
+          break;
+        }
+        // Without a usable candidate the first call has looked at all of them.
+        if (exit || !usable_found) break;
       }
       if (exit) break;
       if (shunt >= p.geometric_pull_out_max_shunts) {
