@@ -42,6 +42,8 @@ constexpr double kCreepTarget = 0.3;
 // [m] The second try's target, where creeping to kCreepTarget was not enough or shunting got stuck
 // otherwise (turned across a single road lane: from further out less turn passes the car ahead).
 constexpr double kCreepFar = 0.6;
+// [m] Room on the kerb side below which creeping comes first (see plan_multi_move).
+constexpr double kCreepFirst = 0.2;
 constexpr int kMaxCreeps = 8;
 constexpr double kMinCreep = 0.01;
 
@@ -315,20 +317,28 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
   // Where the reverse moves have taken the rear corner to the kerb, again after creeping away
   // from it (a car parked 0.15 m from the kerb); where that or the first try got stuck otherwise,
   // again after creeping further.
-  bool left = manoeuvre(0.0);
-  if (out.stopped != StopReason::kNone) return out;
-  if (!left && stuck.rfind("no room to reverse", 0) == 0) {
-    const std::string first = stuck;
-    left = manoeuvre(kCreepTarget);
-    if (!left) stuck = first + "; after creeping away from the kerb: " + stuck;
-    if (out.stopped != StopReason::kNone) return out;
+  // Closer to the kerb than kCreepFirst the full-lock shunts get stuck (almost) always: creep
+  // first there, and only then try without.
+  creep_target = kCreepTarget;
+  const bool close = kerb_room(start) < kCreepFirst;
+  std::vector<double> tries;
+  if (close) {
+    tries = {kCreepTarget, 0.0, kCreepFar};
+  } else {
+    tries = {0.0, kCreepTarget, kCreepFar};
   }
-  if (!left) {
-    const std::string first = stuck;
-    left = manoeuvre(kCreepFar);
-    if (!left) stuck = first + "; after creeping further: " + stuck;
+  std::string why;
+  for (std::size_t t = 0; t < tries.size(); ++t) {
+    // Without creeping first, creeping to kCreepTarget helps only where the rear corner got stuck.
+    if (!close && t == 1 && stuck.rfind("no room to reverse", 0) != 0) continue;
+    const bool left = manoeuvre(tries[t]);
     if (out.stopped != StopReason::kNone) return out;
+    if (left) break;
+    why += (why.empty() ? "" : "; ") +
+           (tries[t] > 0.0 ? "after creeping to " + std::to_string(tries[t]).substr(0, 3) + " m: " : std::string()) +
+           stuck;
   }
+  stuck = why;
   if (!exit) return fail(AttemptOutcome::kNoGeometry, stuck);
 
   // The moves' exact clearance (sampled while driving; the S's is the candidate's).

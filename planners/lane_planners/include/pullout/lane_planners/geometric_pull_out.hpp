@@ -71,7 +71,9 @@
 //   m). Repeated until the lane check's footprint has 0.3 m on the kerb side (at most 8 times,
 //   each gaining 1 cm or more), then 1. and 2. as above. Where it still gets stuck (or got stuck
 //   otherwise: "turned across the road" on a single road lane), once more creeping to 0.6 m of
-//   room: from further out less turn passes the car ahead, and the exit then fits the lane.
+//   room: from further out less turn passes the car ahead, and the exit then fits the lane. A start
+//   with less than 0.2 m of room on the kerb side creeps first (the shunts without get stuck
+//   there almost always), then tries without, then creeps to 0.6 m.
 // "Just clear": every pose of a move keeps the footprint (expanded by
 // lane_departure_check_expansion_margin, and 1 cm) inside the lanes and at least the smallest
 // collision margin plus 2 cm from every static obstacle (sampled every 2 cm at most and bisected
