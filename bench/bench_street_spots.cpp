@@ -97,7 +97,12 @@ int direction_changes(const PullOutPath& path) {
 
 int main(int argc, char** argv) {
   // --why: the evaluation table's last row of every spot the shunting planner leaves unsolved.
-  const bool why = argc > 1 && std::string(argv[1]) == "--why";
+  // --shunts: as --why, with the shunting planner alone (a quick run while working on it).
+  const bool shunts_only = argc > 1 && std::string(argv[1]) == "--shunts";
+  // PULLOUT_BENCH_CPU=1: the tables' times are this thread's CPU time, not wall-clock time (on a
+  // machine loaded by other work).
+  const bool cpu_times = std::getenv("PULLOUT_BENCH_CPU") != nullptr;
+  const bool why = shunts_only || (argc > 1 && std::string(argv[1]) == "--why");
   // --spots: one line per spot for the shipped search (time, thread CPU time, outcome, its
   // evaluation table's freespace rows).
   // --one right|left LANES RADIUS KERB SLACK: that spot alone, shipped search, with --spots' line.
@@ -143,6 +148,7 @@ int main(int argc, char** argv) {
             const Street st = street::make_street(sp, v);
             for (const Planner& pl : planners) {
               if (spots && std::string(pl.name) != "default search") continue;
+              if (shunts_only && std::string(pl.name) != "geometric with shunts") continue;
               const StartPlanner planner(v, pl.params);
               const double cpu0 = thread_cpu_ms();
               const auto t0 = std::chrono::steady_clock::now();
@@ -167,6 +173,18 @@ int main(int argc, char** argv) {
                 std::printf("spot: %s kerb %.2f slack %.1f: %s %s %.1f ms (cpu %.1f ms)%s\n", family.c_str(), kerb,
                             slack, ok ? "solved" : "unsolved", ok ? to_string(r.path.planner_type) : "-", ms, cpu,
                             rows.c_str());
+                // --one: the path's partial paths (direction, length, heading from and to, start).
+                for (std::size_t k = 0; one && ok && k < r.path.partial_paths.size(); ++k) {
+                  const auto& pts = r.path.partial_paths[k].points;
+                  double len = 0.0;
+                  for (std::size_t i = 1; i < pts.size(); ++i) {
+                    len += std::hypot(pts[i].pose.x - pts[i - 1].pose.x, pts[i].pose.y - pts[i - 1].pose.y);
+                  }
+                  std::printf("  partial path %zu: %s %.2f m, yaw %.1f -> %.1f deg, from (%.2f, %.2f)\n", k,
+                              oracle::direction_of(r.path.partial_paths[k]) > 0.0 ? "forward" : "reverse", len,
+                              pts.front().pose.yaw * 180.0 / M_PI, pts.back().pose.yaw * 180.0 / M_PI,
+                              pts.front().pose.x, pts.front().pose.y);
+                }
               }
               if (why && !ok && std::string(pl.name) == "geometric with shunts" && !r.evaluation_table.empty()) {
                 std::printf("unsolved: %s kerb %.2f slack %.1f: %s\n", family.c_str(), kerb, slack,
@@ -174,7 +192,7 @@ int main(int argc, char** argv) {
               }
               for (Tally* t : {&by_family[family][pl.name], &by_slack[pl.name][slack]}) {
                 ++t->total;
-                t->ms.push_back(ms);
+                t->ms.push_back(cpu_times ? cpu : ms);
                 if (ok) {
                   ++t->solved;
                   t->cusps += direction_changes(r.path);
@@ -193,7 +211,8 @@ int main(int argc, char** argv) {
   }
   double load[3] = {0, 0, 0};
   if (::getloadavg(load, 3) != 3) load[0] = -1;
-  std::printf("load average %.2f %.2f %.2f\n\n", load[0], load[1], load[2]);
+  std::printf("load average %.2f %.2f %.2f; times: %s\n\n", load[0], load[1], load[2],
+              cpu_times ? "thread CPU" : "wall clock");
   const auto mean = [](int sum, int n) { return n ? static_cast<double>(sum) / n : 0.0; };
   const auto found_by = [](const Tally& t) {
     std::string out;

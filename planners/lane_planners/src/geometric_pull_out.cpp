@@ -1,6 +1,7 @@
 #include "pullout/lane_planners/geometric_pull_out.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -27,6 +28,8 @@ constexpr int kClearanceBisections = 14;  // a bracket of 1.2 m shrinks below 0.
 // factor above the last, up to kMaxFirstRadius [m].
 constexpr double kFirstRadiusGrowth = 1.05;
 constexpr double kMaxFirstRadius = 200.0;
+// Curvatures (x 1 / R_min) of the gentler two-turn exits from a tilted start (see below).
+constexpr std::array<double, 2> kGentleTurns{0.5, 0.3};
 
 using Edges = std::vector<std::pair<Vec2, Vec2>>;
 
@@ -152,13 +155,18 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
   const double s_base = start_on_road.s + 2.0 * std::sqrt(std::max(q, 0.0));
 
   // Tilted starts (a shunting manoeuvre's): after the S candidates, two turns at R_min joined by
-  // a tangent of 0..9 m (which may turn away from the road first: a counter-arc onto the lane).
-  const int rounds = turn_candidates ? 2 * kEndOffsets : kEndOffsets;
+  // a tangent of 0..9 m (which may turn away from the road first: a counter-arc onto the lane),
+  // then the same at the gentler curvatures of kGentleTurns: from a pose turned across a single
+  // road lane the front corner on the road side swings over the far edge by up to
+  // hypot(R + w, front) - (R + w) while the vehicle straightens (1.1 m at R_min 5.06 m, 0.64 m
+  // at 10 m), so a larger radius is what fits the road's width.
+  const int rounds = turn_candidates ? (2 + static_cast<int>(kGentleTurns.size())) * kEndOffsets : kEndOffsets;
   for (int round = 0; round < rounds; ++round) {
     out.stopped = stop.check();
     if (out.stopped != StopReason::kNone) break;
     const bool tangent_round = round >= kEndOffsets;
-    const int k = tangent_round ? round - kEndOffsets : round;
+    const int k = round % kEndOffsets;
+    const int gentle = round / kEndOffsets - 2;  // index into kGentleTurns, < 0: R_min
     // An S of two arcs to the end pose on the centerline: the first arc at r_first, the second's
     // radius solved (Vorobieva). Where no S reaches it (a start across the road, out of a
     // perpendicular bay), two turns at R_min joined by a k m tangent.
@@ -168,7 +176,10 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
       turns = solve_arc_pair(start, center.pose_at(s_end), r_first, r_min);
     }
     const bool arc_pair = turns.has_value();
-    if (!arc_pair) turns = solve_two_turn(start, window, {kappa, 0.0, static_cast<double>(k)});
+    if (!arc_pair) {
+      const double kappa_turn = gentle < 0 ? kappa : kappa * kGentleTurns[static_cast<std::size_t>(gentle)];
+      turns = solve_two_turn(start, window, {kappa_turn, 0.0, static_cast<double>(k)});
+    }
     if (!turns) {
       PathCandidate none;
       none.rejection = Failure{AttemptOutcome::kNoGeometry, "no two-arc path to the centerline"};

@@ -34,6 +34,18 @@ constexpr double kMaxMoveTurn = kPi / 8.0;
 constexpr double kMaxTilt = kPi / 2.0;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kOutputInterval = 0.1;  // [m] points of a move: chords within 0.3 mm of a 5 m arc
+// [m] Creeping away from the kerb (see plan_multi_move) goes on until the lane check's footprint
+// has this much room on the kerb side (where the shunts get out from: every spot 0.3 m from the
+// kerb with 1.0 m of slack or more and two road lanes is left), at most kMaxCreeps times, while
+// each gains kMinCreep or more.
+constexpr double kCreepTarget = 0.3;
+// [m] The second try's target, where creeping to kCreepTarget was not enough or shunting got stuck
+// otherwise (turned across a single road lane: from further out less turn passes the car ahead).
+constexpr double kCreepFar = 0.6;
+// [m] Room on the kerb side below which creeping comes first (see plan_multi_move).
+constexpr double kCreepFirst = 0.2;
+constexpr int kMaxCreeps = 8;
+constexpr double kMinCreep = 0.01;
 
 struct Move {
   Pose2 from;
@@ -204,50 +216,129 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
     pose = moves.back().at(lim.length);
     return true;
   };
-  // 0. Straight back until just clear of what is behind.
-  if (ctx.max_back_distance > 0.0) add(0.0, -1.0, ctx.max_back_distance);
-
+  // The room [m] beside the kerb side of lane_fp at q, up to kCreepTarget (bisection).
+  double creep_target = 0.0;  // [m] 0: no creeping
+  const auto kerb_room = [&](const Pose2& q) {
+    const auto inside = [&](double e) {
+      Footprint f = lane_fp;
+      f.*kerb_side += e;
+      return ctx.world.footprint_inside(footprint_corners(f, q));
+    };
+    if (inside(creep_target)) return creep_target;
+    double lo = 0.0;
+    double hi = creep_target;
+    for (int i = 0; i < kEndBisections; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (inside(mid) ? lo : hi) = mid;
+    }
+    return lo;
+  };
   const double move_cap = kMaxMoveTurn / kappa;
   std::optional<PathCandidate> exit;
   std::string stuck;
-  for (int shunt = 0;; ++shunt) {
-    out.stopped = stop.check();
-    if (out.stopped != StopReason::kNone) return out;
-    // 1. The S from here.
-    std::vector<CurvaturePath> turn_paths;
-    PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, kInfinity, &turn_paths, moves.size() > 1);
-    for (std::size_t i = 0; i < s.candidates.size(); ++i) {
-      PathCandidate& c = s.candidates[i];
-      if (c.rejection || c.clearance < ctx.smallest_margin) continue;
-      // The S's own clearance samples every 0.5 m and refines around minima; from a tilted start
-      // the corners pass the cars within centimetres of the start, so it is taken densely here.
-      const CurvaturePath& turns = turn_paths[i];
-      const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kDenseSlack);
-      if (dense.distance < ctx.smallest_margin + kDenseSlack) continue;
-      exit = std::move(c);
-      break;
+  // The manoeuvre; with `creep`, first edge away from the kerb (see kCreepTarget). False when it
+  // got stuck (`stuck` says where).
+  const auto manoeuvre = [&](double target) {
+    creep_target = target;
+    moves.clear();
+    pose = start;
+    exit.reset();
+    // 0. Straight back until just clear of what is behind.
+    if (ctx.max_back_distance > 0.0) add(0.0, -1.0, ctx.max_back_distance);
+    // Creeping: forward at full lock towards the road over half the room ahead, at full lock the
+    // other way back to the heading it started with, straight back until just clear: the vehicle
+    // ends beside where it was, 2 R (1 - cos(L / 2R)) further from the kerb for L [m] of room (3 cm
+    // at 0.76 m, 8 cm at 1.26 m). The rear corner on the kerb side dips by about rear x L / 2R on
+    // the way and is back above its start at the end.
+    for (int c = 0; target > 0.0 && c < kMaxCreeps && kerb_room(pose) < target; ++c) {
+      const double before = kerb_room(pose);
+      const std::size_t kept = moves.size();
+      const Pose2 kept_pose = pose;
+      const MoveLimit ahead = drive_until_clear(ctx, pose, 0.0, 1.0, 2.0 * target + 2.0, lane_fp, limit);
+      const double yaw0 = pose.yaw;
+      bool ok = ahead.length >= 2.0 * kMinCreep && add(side * kappa, 1.0, 0.5 * ahead.length);
+      ok = ok && add(-side * kappa, 1.0, std::abs(normalize_angle(pose.yaw - yaw0)) / kappa);
+      ok = ok && add(0.0, -1.0, ctx.max_back_distance);
+      if (!ok || kerb_room(pose) < before + kMinCreep) {
+        moves.resize(kept);
+        pose = kept_pose;
+        break;
+      }
     }
-    if (exit) break;
-    if (shunt >= p.geometric_pull_out_max_shunts) {
-      stuck = "no S onto the road after " + std::to_string(shunt) + " shunts";
-      break;
+    for (int shunt = 0;; ++shunt) {
+      out.stopped = stop.check();
+      if (out.stopped != StopReason::kNone) return false;
+      // 1. The S from here.
+      // The candidates in order up to the first usable one (the rest are not needed when its dense
+      // check passes); all of them only where it does not: the same exit as taking all at once.
+      for (const double usable : {ctx.smallest_margin, kInfinity}) {
+        std::vector<CurvaturePath> turn_paths;
+        PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, usable, &turn_paths, moves.size() > 1);
+        bool usable_found = false;
+        for (std::size_t i = 0; i < s.candidates.size(); ++i) {
+          PathCandidate& c = s.candidates[i];
+          if (c.rejection || c.clearance < ctx.smallest_margin) continue;
+          usable_found = true;
+          // The S's own clearance samples every 0.5 m and refines around minima; from a tilted
+          // start the corners pass the cars within centimetres of the start, so it is taken
+          // densely here.
+          const CurvaturePath& turns = turn_paths[i];
+          const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kDenseSlack);
+          if (dense.distance < ctx.smallest_margin + kDenseSlack) continue;
+          exit = std::move(c);
+          break;
+        }
+        // Without a usable candidate the first call has looked at all of them.
+        if (exit || !usable_found) break;
+      }
+      if (exit) break;
+      if (shunt >= p.geometric_pull_out_max_shunts) {
+        stuck = "no S onto the road after " + std::to_string(shunt) + " shunts";
+        break;
+      }
+      if (tilt_at(pose) > kMaxTilt) {
+        stuck = "turned across the road after " + std::to_string(shunt) + " shunts";
+        break;
+      }
+      // 2. Forward at full lock towards the road, reverse at full lock the other way.
+      if (!add(side * kappa, 1.0, move_cap)) {
+        stuck = "no room to move forward after " + std::to_string(shunt) + " shunts";
+        break;
+      }
+      // Where the rear has reached the kerb at full lock, straight back still makes room ahead (it
+      // takes the rear corner towards the kerb less than a reverse arc up to about 60 degrees).
+      if (!add(-side * kappa, -1.0, move_cap) && !add(0.0, -1.0, move_cap)) {
+        stuck = "no room to reverse after " + std::to_string(shunt) + " shunts and a forward move";
+        break;
+      }
     }
-    if (tilt_at(pose) > kMaxTilt) {
-      stuck = "turned across the road after " + std::to_string(shunt) + " shunts";
-      break;
-    }
-    // 2. Forward at full lock towards the road, reverse at full lock the other way.
-    if (!add(side * kappa, 1.0, move_cap)) {
-      stuck = "no room to move forward after " + std::to_string(shunt) + " shunts";
-      break;
-    }
-    // Where the rear has reached the kerb at full lock, straight back still makes room ahead (it
-    // takes the rear corner towards the kerb less than a reverse arc up to about 60 degrees).
-    if (!add(-side * kappa, -1.0, move_cap) && !add(0.0, -1.0, move_cap)) {
-      stuck = "no room to reverse after " + std::to_string(shunt) + " shunts and a forward move";
-      break;
-    }
+    return exit.has_value();
+  };
+  // Where the reverse moves have taken the rear corner to the kerb, again after creeping away
+  // from it (a car parked 0.15 m from the kerb); where that or the first try got stuck otherwise,
+  // again after creeping further.
+  // Closer to the kerb than kCreepFirst the full-lock shunts get stuck (almost) always: creep
+  // first there, and only then try without.
+  creep_target = kCreepTarget;
+  const bool close = kerb_room(start) < kCreepFirst;
+  std::vector<double> tries;
+  if (close) {
+    tries = {kCreepTarget, 0.0, kCreepFar};
+  } else {
+    tries = {0.0, kCreepTarget, kCreepFar};
   }
+  std::string why;
+  for (std::size_t t = 0; t < tries.size(); ++t) {
+    // Without creeping first, creeping to kCreepTarget helps only where the rear corner got stuck.
+    if (!close && t == 1 && stuck.rfind("no room to reverse", 0) != 0) continue;
+    const bool left = manoeuvre(tries[t]);
+    if (out.stopped != StopReason::kNone) return out;
+    if (left) break;
+    why += (why.empty() ? "" : "; ") +
+           (tries[t] > 0.0 ? "after creeping to " + std::to_string(tries[t]).substr(0, 3) + " m: " : std::string()) +
+           stuck;
+  }
+  stuck = why;
   if (!exit) return fail(AttemptOutcome::kNoGeometry, stuck);
 
   // The moves' exact clearance (sampled while driving; the S's is the candidate's).

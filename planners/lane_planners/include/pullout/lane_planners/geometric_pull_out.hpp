@@ -58,8 +58,22 @@
 //      ahead (or after turning by 22.5 degrees), then reverse at full lock the other way until
 //      just clear of what is behind (where the rear corner meets the kerb at once: straight back):
 //      both turn the vehicle further towards the road; back to 1, at most
-//      geometric_pull_out_max_shunts times. From a turned pose, two turns at R_min joined by a
-//      0..9 m tangent are tried after the S (a counter-arc onto the lane).
+//      geometric_pull_out_max_shunts times. From a turned pose, two turns joined by a 0..9 m
+//      tangent are tried after the S (a counter-arc onto the lane), at R_min, then at 2 and 3.3
+//      R_min: straightening from a pose turned across a single road lane at R_min swings the
+//      front corner on the road side over the far edge.
+//   Where that gets stuck with the rear corner on the kerb side at the kerb ("no room to reverse":
+//   each reverse arc takes it towards the kerb, and once the vehicle is turned about 10 degrees
+//   every reverse does; a car parked 0.15 m from the kerb), the manoeuvre is planned again with
+//   creeping after 0.: forward at full lock towards the road over half the room ahead, at full
+//   lock the other way back to the start's heading, straight back until just clear; the vehicle
+//   ends 2 R_min (1 - cos(L / (2 R_min))) further from the kerb for L of room ahead (3 cm at 0.76
+//   m). Repeated until the lane check's footprint has 0.3 m on the kerb side (at most 8 times,
+//   each gaining 1 cm or more), then 1. and 2. as above. Where it still gets stuck (or got stuck
+//   otherwise: "turned across the road" on a single road lane), once more creeping to 0.6 m of
+//   room: from further out less turn passes the car ahead, and the exit then fits the lane. A start
+//   with less than 0.2 m of room on the kerb side creeps first (the shunts without get stuck
+//   there almost always), then tries without, then creeps to 0.6 m.
 // "Just clear": every pose of a move keeps the footprint (expanded by
 // lane_departure_check_expansion_margin, and 1 cm) inside the lanes and at least the smallest
 // collision margin plus 2 cm from every static obstacle (sampled every 2 cm at most and bisected
