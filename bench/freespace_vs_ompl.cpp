@@ -3,7 +3,7 @@
 //
 //   build/bench/bench_freespace [--problems 24] [--budget-ms 2000] [--seed 5] [--heuristic-weight 2.0]
 //                               [--theta-size N] [--xy-resolution M] [--narrow-penalty P] [--turning-steps S]
-//                               [--ours-only] [--no-peers]
+//                               [--ours-only] [--no-peers] [--case N]
 //
 //   build/bench/bench_freespace --tpcap ../shared/benchmarks/tpcap [--resolution 0.1] [--budget-ms 10000]
 //                               [--case N] [--min-primitive M] [--search-from-goal] [--stall-expansions N]
@@ -452,7 +452,7 @@ int main(int argc, char** argv) {
   bool no_peers = false;          // --no-peers: hybrid A* and rrtstar only (no OMPL RRT*/BIT* peers)
   std::string tpcap;              // --tpcap DIR: the TPCAP cases instead of generated lots
   double tpcap_resolution = 0.1;  // [m]
-  int only_case = 0;              // --case N: this TPCAP case only (1-based)
+  int only_case = 0;              // --case N: this TPCAP case or lot only (1-based)
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(argv[i], "--ours-only") == 0) {
@@ -515,7 +515,8 @@ int main(int argc, char** argv) {
     Problem p;
     if (!tpcap.empty() && only_case > 0 && i + 1 != only_case) continue;
     if (tpcap.empty()) {
-      p = make_problem(i, rng, fp);
+      p = make_problem(i, rng, fp);  // (every lot: each one draws from the generator)
+      if (only_case > 0 && i + 1 != only_case) continue;
     } else if (!make_tpcap(tpcap, i + 1, tpcap_resolution, p)) {
       return 1;
     }

@@ -93,26 +93,31 @@ TEST(DistanceField, MatchesBruteForceAroundLongWalls) {
 
 TEST(DistanceField, ExactOnAGridTallerThanTheStoredColumnDistances) {
   // 140,000 rows: column distances up to 70,000 saturate in storage (at 65,535), which must not
-  // change a distance (the border two cells away is nearer than any saturated column).
-  std::mt19937 rng(9);
-  Grid g{4, 140000, std::vector<std::uint8_t>(4 * 140000, 0)};
-  const int rows[] = {5, 70000, 139990};
-  for (const int r : rows) g.occupied[static_cast<std::size_t>(r) * 4 + 1] = 1;
-  // The oracle over the three occupied cells and the border (the grid is too large to scan per cell).
-  const auto truth = [&](int i, int j) {
-    std::int64_t best = std::min({i + 1, j + 1, g.width - i, g.height - j});
-    best *= best;
-    for (const int r : rows)
-      best = std::min<std::int64_t>(best, std::int64_t{i - 1} * (i - 1) + std::int64_t{j - r} * (j - r));
-    return static_cast<float>(std::sqrt(static_cast<double>(best)) * 0.1);
-  };
-  DistanceField field;
-  ASSERT_EQ(field.build(g.occupied.data(), g.width, g.height, 0.1), StopReason::kNone);
-  std::uniform_int_distribution<int> row(0, g.height - 1), col(0, g.width - 1);
-  for (int k = 0; k < 3000; ++k) {
-    const int i = col(rng);
-    const int j = k < 8 ? 69996 + k : row(rng);
-    ASSERT_EQ(field.at(i, j, g.occupied.data()), truth(i, j)) << i << "," << j;
+  // change a distance (the border is nearer than any saturated column). Width 4: the column
+  // pass's row loops run their scalar tail only; width 40: their vectorised body too (several
+  // 16-bit lanes per step), where a wrapped instead of saturated distance would read as 0.
+  for (const int width : {4, 40}) {
+    SCOPED_TRACE(testing::Message() << "width " << width);
+    std::mt19937 rng(9);
+    Grid g{width, 140000, std::vector<std::uint8_t>(static_cast<std::size_t>(width) * 140000, 0)};
+    const int rows[] = {5, 70000, 139990};
+    for (const int r : rows) g.occupied[static_cast<std::size_t>(r) * width + 1] = 1;
+    // The oracle over the three occupied cells and the border (the grid is too large to scan per cell).
+    const auto truth = [&](int i, int j) {
+      std::int64_t best = std::min({i + 1, j + 1, g.width - i, g.height - j});
+      best *= best;
+      for (const int r : rows)
+        best = std::min<std::int64_t>(best, std::int64_t{i - 1} * (i - 1) + std::int64_t{j - r} * (j - r));
+      return static_cast<float>(std::sqrt(static_cast<double>(best)) * 0.1);
+    };
+    DistanceField field;
+    ASSERT_EQ(field.build(g.occupied.data(), g.width, g.height, 0.1), StopReason::kNone);
+    std::uniform_int_distribution<int> row(0, g.height - 1), col(0, g.width - 1);
+    for (int k = 0; k < 3000; ++k) {
+      const int i = k < 16 ? k % g.width : col(rng);
+      const int j = k < 8 ? 69996 + k : k < 16 ? 65530 + k : row(rng);
+      ASSERT_EQ(field.at(i, j, g.occupied.data()), truth(i, j)) << i << "," << j;
+    }
   }
 }
 

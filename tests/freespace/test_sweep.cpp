@@ -122,5 +122,27 @@ TEST(SweptMotion, DrivingUntilContactStopsBeforeTheFirstCollisionAndNotFarBefore
   EXPECT_GT(cut, 300);  // arcs that do come close and were driven part of the way: the case under test
 }
 
+// sweep_collides grows each piece's hull by the margin, moving a vertex out along its bisector by
+// up to margin x sqrt 2 (a right-angled corner). Its pre-test of the corners' box must cover that
+// much: a 2 m x 1 m body turned 45 degrees, whose front-left corner's bisector points straight
+// up, and one occupied cell just below the grown vertex's tip (margin sqrt 2 = 0.42 m above the
+// corner, the cell from 0.40 m to 0.50 m) collides; the cell above it does not. A pre-test box
+// grown by the margin only (0.30 m) would call the first motion free.
+TEST(SweptMotion, HullGrownByTheMarginReachesPastTheCornersBox) {
+  const Footprint body{1.0, 1.0, 0.5, 0.5};
+  constexpr double kMargin = 0.3;
+  const double c = std::sqrt(0.5);
+  // The front-left corner (1.0, 0.5) in the body frame lands at (5.05, 5.0): column 50's centre.
+  const Pose2 pose{5.05 - (1.0 * c - 0.5 * c), 5.0 - (1.0 * c + 0.5 * c), kPi / 4};
+  for (const int row : {54, 55}) {
+    std::vector<std::uint8_t> cells(100 * 100, 0);
+    cells[static_cast<std::size_t>(row) * 100 + 50] = 1;
+    const Costmap map({}, kRes, 100, 100, cells);
+    const GridCollisionChecker checker(map, body);
+    ASSERT_FALSE(checker.collides(pose));
+    EXPECT_EQ(checker.sweep_collides(pose, pose, kMargin), row == 54) << "occupied row " << row;
+  }
+}
+
 }  // namespace
 }  // namespace pullout

@@ -109,7 +109,11 @@ void DistanceField::fill_band(int band, const std::uint8_t* occupied) const {
     const std::uint8_t* occ = occupied + static_cast<std::size_t>(j) * w;
     const std::uint16_t* d = g;
     g += w;
-    for (std::size_t i = 0; i < w; ++i) g[i] = occ[i] != 0 ? 0 : store(d[i] + 1U);
+    for (std::size_t i = 0; i < w; ++i) {
+      // (a mask instead of a choice: the loop then vectorises)
+      const std::uint16_t keep = occ[i] != 0 ? 0 : 0xFFFF;
+      g[i] = static_cast<std::uint16_t>(store(d[i] + 1U) & keep);
+    }
   }
   seed = above_.data() + static_cast<std::size_t>(band) * w;
   g = column_.data() + static_cast<std::size_t>(j1 - 1) * w;

@@ -373,6 +373,32 @@ bool GridCollisionChecker::sweep_collides(const Pose2& a, const Pose2& b, double
         pts[n++] = Vec2(g->x + x * g->ux - y * g->uy, g->y + x * g->uy + y * g->ux);
       }
     }
+    // Most pieces pass through free space: the box of the eight corners grown by 2 m holds the
+    // grown hull below (its vertices move at most m sqrt 2), so when that box lies inside the
+    // grid and holds no occupied cell, the hull's own box would too and the piece is free, as
+    // the test below would find, without the hull.
+    {
+      double bx_lo = pts[0].x();
+      double bx_hi = bx_lo;
+      double by_lo = pts[0].y();
+      double by_hi = by_lo;
+      for (std::size_t i = 1; i < n; ++i) {
+        bx_lo = std::min(bx_lo, pts[i].x());
+        bx_hi = std::max(bx_hi, pts[i].x());
+        by_lo = std::min(by_lo, pts[i].y());
+        by_hi = std::max(by_hi, pts[i].y());
+      }
+      const double grow = 2.0 * m + 1e-9;
+      bx_lo -= grow;
+      by_lo -= grow;
+      bx_hi += grow;
+      by_hi += grow;
+      if (bx_lo >= 0.0 && by_lo >= 0.0 && bx_hi < grid_width_ && by_hi < grid_height_ &&
+          costmap_.occupied_in_box_inside(std::max(0, cell_first(bx_lo)), std::max(0, cell_first(by_lo)),
+                                          cell_last(bx_hi), cell_last(by_hi)) == 0) {
+        continue;
+      }
+    }
     std::array<Vec2, 16> hull;
     const std::size_t count = convex_hull(pts, hull);
     // Grown by the margin: each edge moved out by it, each vertex to where its two edges now meet

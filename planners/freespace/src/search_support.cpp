@@ -160,13 +160,16 @@ ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuri
 }
 
 float ObstacleHeuristic::estimate(std::int32_t c) const {
-  // The straight line between the cell centres, less 1 % so that float rounding cannot make it
-  // overestimate a path of edges (each at least its length: every rate is at least 1).
+  // The shortest 8-connected path between the cell centres on an empty grid (the octile
+  // distance: diagonal steps, then straight ones), less 1 % so that float rounding cannot make it
+  // overestimate a path of edges (each at least its length: every rate is at least 1). It is the
+  // least any path of edges can cost, and a metric (so consistent); up to 8 % above the straight
+  // line it replaced, it settles fewer cells (the distances are the same).
   const std::int32_t row = c / width_;  // integer division: the cell's row
   const std::int32_t col = c % width_;
-  const auto dx = static_cast<float>(col - toward_x_);
-  const auto dy = static_cast<float>(row - toward_y_);
-  return 0.99F * static_cast<float>(cell_size_) * std::sqrt(dx * dx + dy * dy);
+  const auto dx = static_cast<float>(std::abs(col - toward_x_));
+  const auto dy = static_cast<float>(std::abs(row - toward_y_));
+  return 0.99F * static_cast<float>(cell_size_) * (std::max(dx, dy) + 0.41421356F * std::min(dx, dy));
 }
 
 float ObstacleHeuristic::rate(std::int32_t c) {

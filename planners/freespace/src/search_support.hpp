@@ -84,10 +84,11 @@ struct ObstacleHeuristicConfig {
 // cell's passability and rate are worked out when the search first reaches it, so the cost
 // follows the part of the map the hybrid A* explores, not the map's size. The search from the
 // goal is an A* towards the cell the hybrid A* starts from ("reverse resumable A*": D. Silver,
-// "Cooperative Pathfinding", AIIDE 2005), its estimate the straight-line distance (every rate is
-// at least 1, so it never overestimates and is consistent): where a Dijkstra search would settle
-// every cell closer to the goal than the start (most of a lot whose goal and start lie at opposite
-// ends, and the distance transform under it), it settles a corridor between them. A cell's
+// "Cooperative Pathfinding", AIIDE 2005), its estimate the octile distance (the shortest
+// 8-connected path on an empty grid; every rate is at least 1, so it never overestimates and is
+// consistent): where a Dijkstra search would settle every cell closer to the goal than the start
+// (most of a lot whose goal and start lie at opposite ends, and the distance transform under it),
+// it settles a corridor between them. A cell's
 // distance is final once nothing left on the open list could still lower it, whatever the order:
 // the distances are the same as a Dijkstra search's. Not thread safe (distance() advances the
 // search); one per plan.
