@@ -397,6 +397,28 @@ class ServiceDds : public ::testing::Test {
     ASSERT_TRUE(service_->running());
   }
 
+  // A vehicle that departed from the suite's shared start pose executes its path, which makes its
+  // swept path an obstacle for every later vehicle there (the fleet check). It drives its one
+  // segment to the end, so that the suite's tests see the same empty shoulder in any order.
+  static void drive_out_of_the_way(const std::string& vehicle, std::uint64_t request_id) {
+    const auto path = client_->path_of(vehicle, request_id);
+    ASSERT_TRUE(path.has_value());
+    ASSERT_EQ(path->partial_paths.size(), 1u) << vehicle << " drives one segment";
+    ExecutionProgress gone;
+    gone.vehicle_id = vehicle;
+    gone.request_id = request_id;
+    gone.stamp_ns = system_now_ns();
+    gone.pose = Pose2{path->end_pose.x + 0.5 * std::cos(path->end_pose.yaw),
+                      path->end_pose.y + 0.5 * std::sin(path->end_pose.yaw), path->end_pose.yaw};
+    gone.velocity_mps = 1.0;
+    gone.approved = true;
+    ASSERT_TRUE(client_->send(gone));
+    const auto done = client_->statuses->wait_for([&](const PullOutStatus& s) {
+      return s.vehicle_id == vehicle && s.request_id == request_id && s.state == ExecutionState::kCompleted;
+    });
+    ASSERT_TRUE(done.has_value()) << vehicle << " did not complete";
+  }
+
   static std::unique_ptr<integration::DomainLease> domain_;
   static std::unique_ptr<ServiceChild> service_;
   static std::unique_ptr<TestClient> client_;
@@ -503,6 +525,8 @@ TEST_F(ServiceDds, ProgressAdvancesToCompletion) {
   });
   ASSERT_TRUE(done.has_value());
   EXPECT_EQ(done->current_path_idx, n - 1);
+
+  drive_out_of_the_way("drive-probe", 22);
 }
 
 TEST_F(ServiceDds, NoPathGivesAStopPathWithReasons) {
@@ -580,6 +604,7 @@ TEST_F(ServiceDds, UndecodableProgressIsDroppedAndTheServiceGoesOn) {
   });
   ASSERT_TRUE(moved.has_value()) << "the approval after the undecodable progress was not handled";
   EXPECT_TRUE(service_->running());
+  drive_out_of_the_way("garbage-3", 46);
 }
 
 TEST_F(ServiceDds, CoreValidationRejectsAnInconsistentRequest) {
