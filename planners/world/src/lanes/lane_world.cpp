@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <unordered_set>
 
@@ -167,7 +168,15 @@ Polygon bounds_polygon(const Lane& lane) {
 
 namespace {
 
-bool identical_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+// The stored bits, so that -0.0 and 0.0 (equal as values) count as different input.
+std::uint64_t bits_of(double v) {
+  static_assert(sizeof(std::uint64_t) == sizeof(double));
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits;
+}
+
+bool identical_bits(double a, double b) { return bits_of(a) == bits_of(b); }
 
 bool identical_points(const std::vector<Point2>& a, const std::vector<Point2>& b) {
   if (a.size() != b.size()) return false;
