@@ -196,7 +196,10 @@ TEST(ObstacleHeuristic, AnswersAroundTheRootAreFinalFromTheFirstQuery) {
       }
     };
     const auto [gx, gy] = pick(below);
-    const auto [rx, ry] = pick(above);
+    // Plain ints, not a structured binding: the lambda below captures them (C++17).
+    const std::pair<int, int> root = pick(above);
+    const int rx = root.first;
+    const int ry = root.second;
     const std::vector<float> dist = oracle_distances(m, rate, gx, gy);
     const auto centre = [&](int ci, int cj) {
       return Pose2{(ci + 0.5) * kFactor * kRes, (cj + 0.5) * kFactor * kRes, 0.0};
