@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -19,6 +20,7 @@
 #include "pullout/lanes/lane_world.hpp"
 #include "pullout/maps/osm_loader.hpp"
 #include "pullout/pipeline/start_planner.hpp"
+#include "pullout/safety/rss_check.hpp"
 #include "test_world.hpp"
 
 namespace pullout {
@@ -117,6 +119,48 @@ TEST(BoundedWork, CoordinatesBeyondTheLimitAreRejectedNamingTheField) {
   EXPECT_NE(text.find("goal_pose.y: |y| 3e+07 exceeds 1e+07 m"), std::string::npos) << text;
   EXPECT_NE(text.find("objects[0].length_m: length 2e+07 exceeds 1e+07 m"), std::string::npos) << text;
   EXPECT_FALSE(planner().validate(req).empty());
+}
+
+TEST(BoundedWork, SpeedsBeyondTheLimitAreRejectedNamingTheField) {
+  // A fuzzed request (fuzz/corpus/request/regress_stop_profile_speed_oom.cdr) with an ego speed of
+  // about 1e14 m/s was planned, and the safety check at the start built a stop profile of billions
+  // of samples (out of memory). Speeds are bounded by max_speed_mps (100 m/s).
+  PullOutRequest req = test::straight_shoulder_request();
+  req.ego_velocity_mps = 1e14;
+  req.objects.push_back(test::parked_car(7, 50.0, 3.25));
+  req.objects.back().velocity_mps = -250.0;
+  const PlanningResult r = planner().plan(req, StopCondition());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
+  const std::string text = issues_of(r);
+  EXPECT_NE(text.find("ego_velocity_mps: |speed| 1e+14 exceeds 100 m/s"), std::string::npos) << text;
+  EXPECT_NE(text.find("objects[0].velocity_mps: |speed| 250 exceeds 100 m/s"), std::string::npos) << text;
+
+  req.ego_velocity_mps = -100.0;  // the limit itself is a valid speed, either way
+  req.objects.back().velocity_mps = 100.0;
+  EXPECT_TRUE(planner().validate(req).empty()) << format_issues(planner().validate(req));
+
+  ExecutionProgress progress;
+  progress.velocity_mps = std::numeric_limits<double>::infinity();
+  progress.pose.y = 2e7;
+  const std::string progress_text = format_issues(planner().validate(progress));
+  EXPECT_NE(progress_text.find("progress.velocity_mps: not a finite number (infinite)"), std::string::npos)
+      << progress_text;
+  EXPECT_NE(progress_text.find("progress.pose.y: |y| 2e+07 exceeds 1e+07 m"), std::string::npos) << progress_text;
+  progress.velocity_mps = 3.0;
+  progress.pose.y = 0.0;
+  EXPECT_TRUE(planner().validate(progress).empty());
+}
+
+TEST(BoundedWork, AStopFromAnySpeedHoldsAFewThousandSamples) {
+  // 100 m/s at 0.01 m/s^2 (the smallest deceleration the configuration allows) stops after
+  // 10,001 s: sampled every 5 ms that was 2 million samples, and unbounded for a larger speed.
+  const StopProfile stop(100.0, 0.01, 0.01);
+  EXPECT_LE(stop.samples(), 4200U);
+  // 1 s of jerk ramp (100 - 0.01 / 6 m, down to 99.995 m/s), then 99.995^2 / 0.02 m.
+  EXPECT_NEAR(stop.distance(), 100.0 - 0.01 / 6.0 + 99.995 * 99.995 / 0.02, 1e-3 * stop.distance());
+  const StopProfile never(std::numeric_limits<double>::infinity(), 1.0, 1.0);
+  EXPECT_EQ(never.distance(), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(never.velocity_at(10.0), std::numeric_limits<double>::infinity());
 }
 
 TEST(BoundedWork, ManyLongLanesBuildABoundedWorld) {

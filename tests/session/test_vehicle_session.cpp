@@ -233,6 +233,28 @@ TEST_F(Session, ProgressForAnotherRequestIsIgnored) {
   EXPECT_EQ(status().state, ExecutionState::kWaitingApproval);
 }
 
+TEST_F(Session, ASampleBeyondTheSpeedLimitIsRefusedWithTheFieldAndChangesNothing) {
+  const SessionEffects found = plan(test::straight_shoulder_request());
+  progress(start_of(*found.path), 0.0, true);
+  ASSERT_EQ(status().state, ExecutionState::kExecuting);
+  // After departure a refused approval would insert a stop from this speed: its profile grew with
+  // the speed without bound (an infinite speed never ended).
+  const SessionEffects e = progress(start_of(*found.path), std::numeric_limits<double>::infinity(), false);
+  ASSERT_TRUE(e.status);
+  EXPECT_EQ(e.status->error, "progress.velocity_mps: not a finite number (infinite)");
+  EXPECT_EQ(e.status->state, ExecutionState::kExecuting);
+  EXPECT_FALSE(e.path);
+  EXPECT_TRUE(status().error.empty());
+  const SessionEffects fast = progress(start_of(*found.path), 1e9, false);
+  ASSERT_TRUE(fast.status);
+  EXPECT_EQ(fast.status->error, "progress.velocity_mps: |speed| 1e+09 exceeds 100 m/s");
+  // A valid sample after them is followed as before: the withdrawn approval stops the vehicle.
+  const SessionEffects next = progress(start_of(*found.path), 1.0, false);
+  ASSERT_TRUE(next.status);
+  EXPECT_TRUE(next.status->error.empty());
+  EXPECT_TRUE(next.path);
+}
+
 TEST_F(Session, PrepareTimeCountsOnlyTimeThatPassedOnTheServiceClock) {
   StartPlannerParameters p;
   p.prepare_time_before_start = 2.0;

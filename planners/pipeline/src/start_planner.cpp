@@ -339,6 +339,10 @@ std::vector<RequestIssue> StartPlanner::validate(const PullOutRequest& request) 
   return issues;
 }
 
+std::vector<RequestIssue> StartPlanner::validate(const ExecutionProgress& progress) const {
+  return validate_progress(progress, limits_);
+}
+
 std::shared_ptr<const PlannedWorld> StartPlanner::planned_world(const PullOutRequest& request,
                                                                 std::vector<RequestIssue>& issues) const {
   issues = validate_request_structure(request, limits_, available_planners(), map_ != nullptr, grid_only_allowed());

@@ -41,6 +41,15 @@ class Checker {
     add(field, os.str());
     return false;
   }
+  // A finite speed within max_speed_mps.
+  bool speed(const std::string& field, double v) {
+    if (!finite(field, v)) return false;
+    if (std::abs(v) <= limits_.max_speed_mps) return true;
+    std::ostringstream os;
+    os << "|speed| " << std::abs(v) << " exceeds " << limits_.max_speed_mps << " m/s";
+    add(field, os.str());
+    return false;
+  }
   bool pose(const std::string& field, const Pose2& p) {
     bool ok = coordinate(field, "x", p.x);
     ok = coordinate(field, "y", p.y) && ok;
@@ -115,7 +124,7 @@ void validate_lane(Checker& c, const std::string& f, const Lane& lane) {
 
 void validate_object(Checker& c, const std::string& f, const Object& o, const RequestLimits& limits) {
   c.pose(f + ".pose", o.pose);
-  c.finite(f + ".velocity_mps", o.velocity_mps);
+  c.speed(f + ".velocity_mps", o.velocity_mps);
   if (o.polygon.empty()) {
     if (c.finite(f + ".length_m", o.length_m) && o.length_m <= 0.0) c.add(f + ".length_m", "must be positive");
     if (c.finite(f + ".width_m", o.width_m) && o.width_m <= 0.0) c.add(f + ".width_m", "must be positive");
@@ -155,7 +164,7 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
     c.add("vehicle_id", "longer than " + std::to_string(kMaxVehicleIdBytes) + " bytes");
   }
   c.pose("ego_pose", r.ego_pose);
-  c.finite("ego_velocity_mps", r.ego_velocity_mps);
+  c.speed("ego_velocity_mps", r.ego_velocity_mps);
   c.pose("goal_pose", r.goal_pose);
   if (c.finite("deadline_ms", r.deadline_ms) && (r.deadline_ms < 0.0 || r.deadline_ms > limits.max_deadline_ms)) {
     std::ostringstream os;
@@ -225,6 +234,14 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
       c.add(f, std::string("planner '") + to_string(t) + "' listed twice");
     }
   }
+  return issues;
+}
+
+std::vector<RequestIssue> validate_progress(const ExecutionProgress& progress, const RequestLimits& limits) {
+  std::vector<RequestIssue> issues;
+  Checker c(limits, issues);
+  c.pose("progress.pose", progress.pose);
+  c.speed("progress.velocity_mps", progress.velocity_mps);
   return issues;
 }
 

@@ -16,4 +16,8 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& reque
                                                      const std::vector<PlannerType>& available, bool has_map,
                                                      bool allow_grid_only = false);
 
+// A progress sample's pose (finite, within max_coordinate_m) and speed (finite, within
+// max_speed_mps): what the safety check and the stop it inserts are computed from.
+std::vector<RequestIssue> validate_progress(const ExecutionProgress& progress, const RequestLimits& limits);
+
 }  // namespace pullout

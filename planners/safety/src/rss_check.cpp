@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "pullout/geometry/polygon.hpp"
@@ -13,6 +14,7 @@ namespace {
 constexpr double kStoppedObjectVelocity = 0.3;  // [m/s]
 // Integration step of the stop profile.
 constexpr double kStopProfileStep = 0.005;  // [s]
+constexpr double kStopProfileMaxSteps = 4096.0;
 
 // Distance travelled after tau seconds from v0 with acceleration a, the speed clamped to
 // [v_min, v_max].
@@ -225,10 +227,21 @@ StopProfile::StopProfile(double v0, double max_deceleration, double max_jerk) {
   double a = 0.0;
   s_.push_back(0.0);
   v_.push_back(v);
+  // The stop lasts at most v / max_deceleration + max_deceleration / max_jerk; the step grows
+  // with it so that a stop from any speed costs at most about kStopProfileMaxSteps samples.
+  const double duration = v / max_deceleration + max_deceleration / max_jerk;
+  if (!(max_deceleration > 0.0) || !(max_jerk > 0.0) || !std::isfinite(duration)) {
+    // Never stops (the callers validate speeds and parameters; this keeps the work finite).
+    distance_ = std::numeric_limits<double>::infinity();
+    return;
+  }
+  const double step = std::max(kStopProfileStep, duration / kStopProfileMaxSteps);
+  s_.reserve(static_cast<std::size_t>(duration / step) + 2);
+  v_.reserve(s_.capacity());
   while (v > 0.0) {
-    const double a_next = std::min(a + max_jerk * kStopProfileStep, max_deceleration);
+    const double a_next = std::min(a + max_jerk * step, max_deceleration);
     const double a_mid = 0.5 * (a + a_next);
-    double dt = kStopProfileStep;
+    double dt = step;
     if (v - a_mid * dt <= 0.0) dt = v / a_mid;  // the last step ends exactly at v = 0
     s += v * dt - 0.5 * a_mid * dt * dt;
     v = std::max(v - a_mid * dt, 0.0);
@@ -240,7 +253,7 @@ StopProfile::StopProfile(double v0, double max_deceleration, double max_jerk) {
 }
 
 double StopProfile::velocity_at(double s) const {
-  if (s <= 0.0) return v_.front();
+  if (s <= 0.0 || s_.size() < 2) return v_.front();
   if (s >= distance_) return 0.0;
   const auto it = std::upper_bound(s_.begin(), s_.end(), s);
   const auto i = static_cast<std::size_t>(it - s_.begin());

@@ -296,6 +296,14 @@ SessionEffects VehicleSession::on_progress(const ExecutionProgress& progress, Cl
                ")";
     return out;
   }
+  if (const std::vector<RequestIssue> issues = planner_.validate(progress); !issues.empty()) {
+    // Nothing to measure or to stop from (the stop profile grows with the speed): the vehicle
+    // hears why on a status of its own; the session's state is unchanged.
+    out.note = "progress ignored: " + format_issues(issues);
+    out.status = status_;
+    out.status->error = format_issues(issues);
+    return out;
+  }
   const Accepted current{progress.stamp_ns, now, progress.pose, progress.velocity_mps};
   std::string why;
   if (last_sample_ && !follows(*last_sample_, current, why)) {

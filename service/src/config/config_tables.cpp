@@ -416,6 +416,9 @@ const Table<RequestLimits>& limits_table() {
             "|x|, |y| of every point and pose, object lengths and widths"),
       field("max_horizon_lane_length_m", &T::max_horizon_lane_length_m, "m", above(0.0),
             "lane bounds kept within the planning horizon, all lanes"),
+      // 1,000 m/s: Mach 3; the stop profile and the predictions stay bounded below it.
+      field("max_speed_mps", &T::max_speed_mps, "m/s", in_open_closed(0.0, 1000.0),
+            "|speed| of the ego, every object and a progress sample"),
   }};
   return t;
 }

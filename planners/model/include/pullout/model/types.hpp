@@ -289,7 +289,9 @@ struct PullOutStatus {
   PlannerType planner_type{PlannerType::kNone};
   std::vector<PlannerAttempt> evaluation_table;
   std::string stop_reason;  // kNoPath, kWaitingApproval, kWaitingSafety: why the vehicle must stand
-  std::string error;        // kRejected: "<field>: <problem>" lines
+  // kRejected: the request's "<field>: <problem>" lines. In any state, on the status answering a
+  // refused progress sample (out of limits): its "progress.<field>: <problem>" lines.
+  std::string error;
   double planning_time_ms{0.0};
   // Dynamic safety of the path at the last progress sample.
   bool safe{true};

@@ -85,6 +85,10 @@ struct RequestLimits {
   // after the crop. A straight lane crossing the horizon keeps about 2 x 2 x 400 m; the default
   // admits several hundred of those, and bounds the zig-zag lanes no crop can shorten.
   double max_horizon_lane_length_m{500000.0};
+  // [m/s] |speed| a request or a progress sample may report: ego_velocity_mps, every object's
+  // velocity_mps, a progress sample's velocity_mps. The safety check's stop profile and the ego and
+  // object predictions grow with the speed; 100 m/s (360 km/h) is beyond any road vehicle.
+  double max_speed_mps{100.0};
 };
 
 }  // namespace pullout

@@ -126,6 +126,9 @@ class StartPlanner {
 
   // Only the validation step of plan(): every problem of the request, empty when valid.
   std::vector<RequestIssue> validate(const PullOutRequest& request) const;
+  // A progress sample's problems ("progress.velocity_mps: |speed| 1e+300 exceeds 100 m/s"), empty when its
+  // pose and speed are within the limits.
+  std::vector<RequestIssue> validate(const ExecutionProgress& progress) const;
 
   // The request's vehicle problems: both a profile and dimensions, an unknown profile
   // ("vehicle_profile: unknown profile 'x' (the service has bus, car, van)"), each dimension outside

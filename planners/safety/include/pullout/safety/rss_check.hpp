@@ -73,11 +73,13 @@ RssVerdict check_rss(const std::vector<TimedPose>& ego_path, const Footprint& eg
                      const SafetyCheckParams& p, double hysteresis);
 
 // A jerk-limited stop from v0 >= 0 with zero initial acceleration: the deceleration ramps up at
-// max_jerk to max_deceleration and holds until the speed is 0.
+// max_jerk to max_deceleration and holds until the speed is 0. Sampled every 5 ms, or coarser for a
+// stop longer than 20 s, so that it holds at most about 4,100 samples for any speed.
 class StopProfile {
  public:
   StopProfile(double v0, double max_deceleration, double max_jerk);
   double distance() const { return distance_; }  // [m] travelled until stopped
+  std::size_t samples() const { return s_.size(); }
   // Speed [m/s] after travelling s metres (0 from distance() on).
   double velocity_at(double s) const;
 
