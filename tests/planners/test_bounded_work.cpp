@@ -123,8 +123,8 @@ TEST(BoundedWork, CoordinatesBeyondTheLimitAreRejectedNamingTheField) {
 
 TEST(BoundedWork, SpeedsBeyondTheLimitAreRejectedNamingTheField) {
   // A fuzzed request (fuzz/corpus/request/regress_stop_profile_speed_oom.cdr) with an ego speed of
-  // about 1e14 m/s was planned, and the safety check at the start built a stop profile of billions
-  // of samples (out of memory). Speeds are bounded by max_speed_mps (100 m/s).
+  // 2e236 m/s was planned, and the safety check at the start then built its stop profile until it
+  // ran out of memory. Speeds are bounded by max_speed_mps (100 m/s).
   PullOutRequest req = test::straight_shoulder_request();
   req.ego_velocity_mps = 1e14;
   req.objects.push_back(test::parked_car(7, 50.0, 3.25));
