@@ -11,6 +11,7 @@
 #include <limits>
 #include <random>
 
+#include "../sampling.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/geometry/angle.hpp"
 
@@ -390,7 +391,7 @@ TEST(GridCollisionChecker, AgreesWithReferenceNearObstaclesAndBoundIsALowerBound
     std::uniform_int_distribution<std::size_t> pick(0, cells.size() - 1);
     std::uniform_real_distribution<double> off(-1.0, 1.0), yaw(-kPi, kPi);
     const double reach = 1.5 * cs.fp.length() + 1.0;
-    for (int n = 0; n < 3000; ++n) {
+    for (int n = 0; n < test::sampled_count(3000); ++n) {
       const auto [ci, cj] = cells[pick(rng)];
       const Vec2 centre = m.to_map({ci + 0.5, cj + 0.5});
       const Pose2 pose{centre.x() + reach * off(rng), centre.y() + reach * off(rng), yaw(rng)};

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <random>
 
+#include "../sampling.hpp"
 #include "pullout/freespace/costmap.hpp"
 #include "pullout/freespace/grid_collision_checker.hpp"
 #include "pullout/geometry/angle.hpp"
@@ -211,7 +212,7 @@ TEST(ExactObstacles, RandomFootprintsAgreeWithPolygonOracleOnRandomMaps) {
       const double right = std::uniform_real_distribution<double>(0.1, 1.8)(rng);
       const GridCollisionChecker checker(map, Footprint{front, rear, left, right});
       std::uniform_real_distribution<double> off(-(front + left), front + left);
-      for (int n = 0; n < 1500; ++n) {
+      for (int n = 0; n < test::sampled_count(1500); ++n) {
         const auto& b = obstacles[std::uniform_int_distribution<std::size_t>(0, obstacles.size() - 1)(rng)];
         const std::size_t k = std::uniform_int_distribution<std::size_t>(0, b.size() - 1)(rng);
         const Vec2 p = b[k] + unit(rng) * (b[(k + 1) % b.size()] - b[k]);
@@ -230,9 +231,9 @@ TEST(ExactObstacles, RandomFootprintsAgreeWithPolygonOracleOnRandomMaps) {
       }
     }
   }
-  EXPECT_GT(compared, 70000);
-  EXPECT_GT(collisions, 10000);
-  EXPECT_GT(free_near, 1000) << "free poses within a cell of a shape";
+  EXPECT_GT(compared, test::sampled_count(70000));
+  EXPECT_GT(collisions, test::sampled_count(10000));
+  EXPECT_GT(free_near, test::sampled_count(1000)) << "free poses within a cell of a shape";
 }
 
 // partial_shapes_in_row gives the set of shapes of the occupied cells of the row range, which the

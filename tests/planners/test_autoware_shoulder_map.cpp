@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "../sampling.hpp"
 #include "map_cases.hpp"
 #include "path_oracles.hpp"
 #include "pullout/collision/footprint.hpp"
@@ -155,7 +156,7 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
   const Footprint body = vehicle_footprint(config.vehicle);
   for (const Lanelet& shoulder : map->lanelets()) {
     if (shoulder.subtype != LaneletSubtype::kRoadShoulder) continue;
-    ++shoulders;
+    if (!test::sampled(shoulders++)) continue;
     const auto c = shoulder_case(*map, shoulder);
     ASSERT_TRUE(c) << "shoulder " << shoulder.id << " has no road beside it";
     const LaneWorld own({*to_lane(shoulder)});
@@ -205,9 +206,12 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
               << " starts\n"
               << text;
   }
-  // Floors measured on 2026-12-02 (bench/RESULTS.md): a change that loses a shoulder fails here.
-  EXPECT_GE(passed[PlannerType::kShift], kShiftShoulderFloor);
-  EXPECT_GE(passed[PlannerType::kGeometric], kGeometricShoulderFloor);
+  // Floors measured on 2026-12-02 (bench/RESULTS.md): a change that loses a shoulder fails here
+  // (in scripts/test, which plans every shoulder; the sanitizer build plans a sample).
+  if (!test::kUnderSanitizer) {
+    EXPECT_GE(passed[PlannerType::kShift], kShiftShoulderFloor);
+    EXPECT_GE(passed[PlannerType::kGeometric], kGeometricShoulderFloor);
+  }
   // A found path starts at the vehicle (the shift path started up to 0.6 m away where the
   // vehicle stood beside a corner of the road's centerline polyline).
   for (PlannerType type : {PlannerType::kShift, PlannerType::kGeometric}) {
