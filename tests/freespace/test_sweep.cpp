@@ -84,6 +84,38 @@ TEST(SweptMotion, AnArcArcFreeAcceptsIsFreeAtEveryPose) {
   EXPECT_GT(refused, 500);
 }
 
+// The search takes a free primitive's end pose from arc_free instead of driving the arc again:
+// it must be the very pose the test used and the arc's own end, with the same answer and clearance.
+TEST(SweptMotion, TheEndPoseArcFreeGivesIsTheArcsEnd) {
+  std::mt19937 rng(5);
+  const Costmap m = cluttered_map(rng);
+  const GridCollisionChecker checker(m, kCar);
+  std::uniform_real_distribution<double> pos(1.0, 19.0);
+  std::uniform_real_distribution<double> yaw(-kPi, kPi);
+  std::uniform_int_distribution<int> steer(-1, 1);
+  int accepted = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Pose2 start{pos(rng), pos(rng), yaw(rng)};
+    double start_clearance = 0.0;
+    if (checker.collides(start, start_clearance)) continue;
+    const fd::Arc arc(start, steer(rng) / kRadius);
+    const double d = (trial % 2 == 0 ? 1.0 : -1.0) * 0.5;
+    double plain_clearance = 0.0;
+    double clearance = 0.0;
+    Pose2 end{-1.0, -1.0, -1.0};
+    const bool plain = fd::arc_free(checker, arc, start_clearance, d, plain_clearance);
+    ASSERT_EQ(fd::arc_free(checker, arc, start_clearance, d, clearance, end), plain);
+    if (!plain) continue;
+    ++accepted;
+    const Pose2 expected = arc.at(d);
+    EXPECT_EQ(end.x, expected.x);
+    EXPECT_EQ(end.y, expected.y);
+    EXPECT_EQ(end.yaw, expected.yaw);
+    EXPECT_EQ(clearance, plain_clearance);
+  }
+  EXPECT_GT(accepted, 100);
+}
+
 TEST(SweptMotion, DrivingUntilContactStopsBeforeTheFirstCollisionAndNotFarBeforeIt) {
   std::mt19937 rng(11);
   const Costmap m = cluttered_map(rng);

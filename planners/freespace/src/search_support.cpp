@@ -70,10 +70,16 @@ bool sweep_to_free_end(const GridCollisionChecker& checker, const Arc& arc, doub
 
 bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
               double& end_clearance) {
+  Pose2 end;
+  return arc_free(checker, arc, start_clearance, distance, end_clearance, end);
+}
+
+bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+              double& end_clearance, Pose2& end) {
   double c = 1.0;
   double sn = 0.0;
   // The end first: where the search stops, tested exactly (and the likeliest to collide).
-  const Pose2 end = arc.at(distance, c, sn);
+  end = arc.at(distance, c, sn);
   if (checker.collides(end, c, sn, end_clearance)) return false;
   return sweep_to_free_end(checker, arc, start_clearance, distance, end_clearance);
 }
