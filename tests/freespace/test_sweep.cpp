@@ -116,6 +116,25 @@ TEST(SweptMotion, TheEndPoseArcFreeGivesIsTheArcsEnd) {
   EXPECT_GT(accepted, 100);
 }
 
+// The hull tests take each pose's cos and sin of its heading from Arc::at instead of computing
+// them from the pose's yaw: they must be the very values std::cos and std::sin give for that yaw,
+// or the hulls (and so the search's answers) would change.
+TEST(SweptMotion, TheHeadingsCosAndSinFromTheArcAreThoseOfThePosesYaw) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> yaw(-4.0 * kPi, 4.0 * kPi);
+  std::uniform_real_distribution<double> distance(-3.0, 3.0);
+  std::uniform_int_distribution<int> steer(-2, 2);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Pose2 start{1.0, 2.0, yaw(rng)};
+    const fd::Arc arc(start, steer(rng) / kRadius);
+    double c = 0.0;
+    double s = 0.0;
+    const Pose2 p = arc.at(distance(rng), c, s);
+    ASSERT_EQ(c, std::cos(p.yaw)) << "yaw " << p.yaw;
+    ASSERT_EQ(s, std::sin(p.yaw)) << "yaw " << p.yaw;
+  }
+}
+
 TEST(SweptMotion, DrivingUntilContactStopsBeforeTheFirstCollisionAndNotFarBeforeIt) {
   std::mt19937 rng(11);
   const Costmap m = cluttered_map(rng);

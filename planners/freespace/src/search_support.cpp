@@ -45,11 +45,19 @@ bool sweep_free(const GridCollisionChecker& checker, const Arc& arc, double sign
   const double turn = std::abs(arc.curvature()) * (to - from);
   const int pieces = std::max(1, static_cast<int>(std::ceil(turn / kMaxSweepTurn)));
   const double margin = checker.sweep_margin(arc.curvature(), turn / pieces) + kSweepSafety;
-  Pose2 previous = arc.at(sign * from);
+  // Each pose's cos and sin of its heading from Arc::at (the same values the checker would compute
+  // from its yaw), and each inner pose shared by two hull tests: one sincos per pose, not four.
+  double c0 = 1.0;
+  double s0 = 0.0;
+  Pose2 previous = arc.at(sign * from, c0, s0);
   for (int i = 1; i <= pieces; ++i) {
-    const Pose2 next = arc.at(sign * (from + (to - from) * i / pieces));
-    if (checker.sweep_collides(previous, next, margin)) return false;
+    double c1 = 1.0;
+    double s1 = 0.0;
+    const Pose2 next = arc.at(sign * (from + (to - from) * i / pieces), c1, s1);
+    if (checker.sweep_collides(previous, c0, s0, next, c1, s1, margin)) return false;
     previous = next;
+    c0 = c1;
+    s0 = s1;
   }
   return true;
 }

@@ -23,6 +23,7 @@ Pose2 drive(const Pose2& from, double curvature, double distance);
 class Arc {
  public:
   Arc(const Pose2& from, double curvature);
+  // cos_yaw, sin_yaw: std::cos and std::sin of from.yaw (the checker gets them from at()).
   Arc(const Pose2& from, double cos_yaw, double sin_yaw, double curvature);
   // The pose after `distance` [m] (negative: reverse), with cos and sin of its heading.
   Pose2 at(double distance, double& cos_yaw, double& sin_yaw) const;
