@@ -136,8 +136,15 @@ double free_prefix(const GridCollisionChecker& checker, const Arc& arc, double s
 bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance,
                       double spacing) {
   const int n = std::max(1, static_cast<int>(std::ceil(std::abs(distance) / spacing)));
+  // One arc for all samples, and each sample's cos and sin of its heading from it (the values
+  // the checker would compute from the yaw): one sincos per sample instead of three.
+  const Arc arc(from, curvature);
   for (int i = n; i >= 1; --i) {  // the end first: it is the likeliest to collide
-    if (checker.collides(drive(from, curvature, distance * i / n))) return false;
+    double c = 1.0;
+    double sn = 0.0;
+    double bound = 0.0;
+    const Pose2 pose = arc.at(distance * i / n, c, sn);
+    if (checker.collides(pose, c, sn, bound)) return false;
   }
   return true;
 }
