@@ -84,6 +84,57 @@ TEST(SweptMotion, AnArcArcFreeAcceptsIsFreeAtEveryPose) {
   EXPECT_GT(refused, 500);
 }
 
+// The search takes a free primitive's end pose from arc_free instead of driving the arc again:
+// it must be the very pose the test used and the arc's own end, with the same answer and clearance.
+TEST(SweptMotion, TheEndPoseArcFreeGivesIsTheArcsEnd) {
+  std::mt19937 rng(5);
+  const Costmap m = cluttered_map(rng);
+  const GridCollisionChecker checker(m, kCar);
+  std::uniform_real_distribution<double> pos(1.0, 19.0);
+  std::uniform_real_distribution<double> yaw(-kPi, kPi);
+  std::uniform_int_distribution<int> steer(-1, 1);
+  int accepted = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Pose2 start{pos(rng), pos(rng), yaw(rng)};
+    double start_clearance = 0.0;
+    if (checker.collides(start, start_clearance)) continue;
+    const fd::Arc arc(start, steer(rng) / kRadius);
+    const double d = (trial % 2 == 0 ? 1.0 : -1.0) * 0.5;
+    double plain_clearance = 0.0;
+    double clearance = 0.0;
+    Pose2 end{-1.0, -1.0, -1.0};
+    const bool plain = fd::arc_free(checker, arc, start_clearance, d, plain_clearance);
+    ASSERT_EQ(fd::arc_free(checker, arc, start_clearance, d, clearance, end), plain);
+    if (!plain) continue;
+    ++accepted;
+    const Pose2 expected = arc.at(d);
+    EXPECT_EQ(end.x, expected.x);
+    EXPECT_EQ(end.y, expected.y);
+    EXPECT_EQ(end.yaw, expected.yaw);
+    EXPECT_EQ(clearance, plain_clearance);
+  }
+  EXPECT_GT(accepted, 100);
+}
+
+// The hull tests take each pose's cos and sin of its heading from Arc::at instead of computing
+// them from the pose's yaw: they must be the very values std::cos and std::sin give for that yaw,
+// or the hulls (and so the search's answers) would change.
+TEST(SweptMotion, TheHeadingsCosAndSinFromTheArcAreThoseOfThePosesYaw) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> yaw(-4.0 * kPi, 4.0 * kPi);
+  std::uniform_real_distribution<double> distance(-3.0, 3.0);
+  std::uniform_int_distribution<int> steer(-2, 2);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Pose2 start{1.0, 2.0, yaw(rng)};
+    const fd::Arc arc(start, steer(rng) / kRadius);
+    double c = 0.0;
+    double s = 0.0;
+    const Pose2 p = arc.at(distance(rng), c, s);
+    ASSERT_EQ(c, std::cos(p.yaw)) << "yaw " << p.yaw;
+    ASSERT_EQ(s, std::sin(p.yaw)) << "yaw " << p.yaw;
+  }
+}
+
 TEST(SweptMotion, DrivingUntilContactStopsBeforeTheFirstCollisionAndNotFarBeforeIt) {
   std::mt19937 rng(11);
   const Costmap m = cluttered_map(rng);

@@ -354,9 +354,14 @@ double GridCollisionChecker::sweep_margin(double curvature, double turn) const {
 }
 
 bool GridCollisionChecker::sweep_collides(const Pose2& a, const Pose2& b, double margin) const {
+  return sweep_collides(a, std::cos(a.yaw), std::sin(a.yaw), b, std::cos(b.yaw), std::sin(b.yaw), margin);
+}
+
+bool GridCollisionChecker::sweep_collides(const Pose2& a, double cos_a, double sin_a, const Pose2& b, double cos_b,
+                                          double sin_b, double margin) const {
   const Footprint& f = footprint_;
-  const GridPose ga = grid_pose(a, std::cos(a.yaw), std::sin(a.yaw));
-  const GridPose gb = grid_pose(b, std::cos(b.yaw), std::sin(b.yaw));
+  const GridPose ga = grid_pose(a, cos_a, sin_a);
+  const GridPose gb = grid_pose(b, cos_b, sin_b);
   const double m = margin * inv_resolution_;
   std::vector<std::uint32_t> shapes;
   // Piece by piece along the body: the hull of a short piece's two places hugs its sweep much

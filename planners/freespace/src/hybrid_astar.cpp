@@ -37,6 +37,9 @@ struct Node {
   double length{0.0};        // [m] arc length of the primitive that led here (cut short at a contact)
   std::int8_t steer{0};      // steer index of the primitive that led here
   std::int8_t direction{0};  // +1 / -1 of that primitive, 0 at the start
+  // [m] obstacle-aware distance from `pose` to the target, set when the node is added (its
+  // expansion needs it again for the shots: one lookup instead of two).
+  double h2d{0.0};
   bool closed{false};
   bool fine{false};  // its lattice cell is a fine one (see key())
 };
@@ -77,7 +80,7 @@ class Search {
     Node root;
     root.pose = root_;
     root.clearance = static_cast<float>(clearance);
-    add_node(root);
+    add_node(root, key(root.pose, root.fine));
   }
 
   // One expansion (or none, when only superseded entries were popped).
@@ -97,7 +100,7 @@ class Search {
         return State::kFound;
       }
       // Analytic expansion: every expansion near the target, less often far from it.
-      const double h2d = heuristic_.distance(node.pose);
+      const double h2d = node.h2d;
       if (h2d < best_h2d_ - kProgress) {
         best_h2d_ = h2d;
         last_progress_ = expansions_;
@@ -177,8 +180,8 @@ class Search {
   // Far from the goal the 2D distance dominates (a Reeds-Shepp path exceeds the straight line by
   // at most a few turning radii, and obstacles lengthen the 2D distance): the Reeds-Shepp term,
   // the costliest part of an expansion, is only computed within kReedsSheppRange radii.
-  double heuristic(const Pose2& p) const {
-    const double h2d = heuristic_.distance(p);
+  // `h2d`: the obstacle-aware distance of p (heuristic_.distance(p)).
+  double heuristic(const Pose2& p, double h2d) const {
     if (!std::isfinite(h2d)) return h2d;
     if (h2d > kReedsSheppRange * config_.turning_radius) return config_.distance_heuristic_weight * h2d;
     return config_.distance_heuristic_weight * std::max(h2d, rs_.distance(p, target_));
@@ -197,17 +200,20 @@ class Search {
   }
 
   // Adds a node unless its lattice cell holds a cheaper one; pushes it on the open list.
-  void add_node(const Node& node) {
-    std::int32_t* slot = table_.find_or_insert(key(node.pose, node.fine));
+  // `cell`: key(node.pose, node.fine).
+  void add_node(const Node& node, std::uint64_t cell) {
+    std::int32_t* slot = table_.find_or_insert(cell);
     if (*slot >= 0) {
       Node& existing = nodes_[static_cast<std::size_t>(*slot)];
       if (existing.closed || existing.g <= node.g) return;
       existing.closed = true;  // superseded: its heap entry is skipped when popped
     }
-    const double h = heuristic(node.pose);
+    const double h2d = heuristic_.distance(node.pose);
+    const double h = heuristic(node.pose, h2d);
     if (!std::isfinite(h)) return;
     *slot = static_cast<std::int32_t>(nodes_.size());
     nodes_.push_back(node);
+    nodes_.back().h2d = h2d;
     open_.push({node.g + h, *slot});
   }
 
@@ -228,6 +234,7 @@ class Search {
       double distance;  // [m] signed
       Pose2 pose;
       double clearance;
+      std::uint64_t coarse_key;  // key(pose, false); 0 for a move driven until contact (not computed)
     };
     constexpr std::size_t kMaxMoves = 2 * (2 * static_cast<std::size_t>(kMaxTurningSteps) + 1);
     std::array<Move, kMaxMoves> moves;
@@ -242,13 +249,14 @@ class Search {
         const fd::Arc arc(parent.pose, c, s, curvature(steer));
         const double distance = direction * config_.primitive_length;
         double clearance = 0.0;
-        if (!fd::arc_free(checker_, arc, parent.clearance, distance, clearance)) {
-          refused[refused_count++] = {direction, steer, distance, {}, 0.0};
+        Pose2 pose;
+        if (!fd::arc_free(checker_, arc, parent.clearance, distance, clearance, pose)) {
+          refused[refused_count++] = {direction, steer, distance, {}, 0.0, 0};
           continue;
         }
-        const Pose2 pose = arc.at(distance);
-        open += key(pose, false) != coarse_parent ? 1 : 0;
-        moves[free_count++] = {direction, steer, distance, pose, clearance};
+        const std::uint64_t coarse_key = key(pose, false);
+        open += coarse_key != coarse_parent ? 1 : 0;
+        moves[free_count++] = {direction, steer, distance, pose, clearance, coarse_key};
       }
     }
     const bool constrained = open < kOpenPrimitives;
@@ -270,7 +278,8 @@ class Search {
     const std::uint64_t parent_key = key(parent.pose, parent.fine);
     for (std::size_t i = 0; i < free_count; ++i) {
       const Move& m = moves[i];
-      if (key(m.pose, fine) == parent_key) continue;
+      const std::uint64_t cell = fine ? key(m.pose, true) : m.coarse_key;
+      if (cell == parent_key) continue;
       const double driven = std::abs(m.distance);
       double cost = driven * (1.0 + config_.curve_weight * std::abs(m.steer) / steps);
       if ((m.direction < 0) != backward_) cost *= 1.0 + config_.reverse_weight;  // the vehicle reverses
@@ -284,7 +293,7 @@ class Search {
       child.steer = static_cast<std::int8_t>(m.steer);
       child.direction = static_cast<std::int8_t>(m.direction);
       child.fine = fine;
-      add_node(child);
+      add_node(child, cell);
     }
   }
 

@@ -45,11 +45,19 @@ bool sweep_free(const GridCollisionChecker& checker, const Arc& arc, double sign
   const double turn = std::abs(arc.curvature()) * (to - from);
   const int pieces = std::max(1, static_cast<int>(std::ceil(turn / kMaxSweepTurn)));
   const double margin = checker.sweep_margin(arc.curvature(), turn / pieces) + kSweepSafety;
-  Pose2 previous = arc.at(sign * from);
+  // Each pose's cos and sin of its heading from Arc::at (the same values the checker would compute
+  // from its yaw), and each inner pose shared by two hull tests: one sincos per pose, not four.
+  double c0 = 1.0;
+  double s0 = 0.0;
+  Pose2 previous = arc.at(sign * from, c0, s0);
   for (int i = 1; i <= pieces; ++i) {
-    const Pose2 next = arc.at(sign * (from + (to - from) * i / pieces));
-    if (checker.sweep_collides(previous, next, margin)) return false;
+    double c1 = 1.0;
+    double s1 = 0.0;
+    const Pose2 next = arc.at(sign * (from + (to - from) * i / pieces), c1, s1);
+    if (checker.sweep_collides(previous, c0, s0, next, c1, s1, margin)) return false;
     previous = next;
+    c0 = c1;
+    s0 = s1;
   }
   return true;
 }
@@ -70,10 +78,16 @@ bool sweep_to_free_end(const GridCollisionChecker& checker, const Arc& arc, doub
 
 bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
               double& end_clearance) {
+  Pose2 end;
+  return arc_free(checker, arc, start_clearance, distance, end_clearance, end);
+}
+
+bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+              double& end_clearance, Pose2& end) {
   double c = 1.0;
   double sn = 0.0;
   // The end first: where the search stops, tested exactly (and the likeliest to collide).
-  const Pose2 end = arc.at(distance, c, sn);
+  end = arc.at(distance, c, sn);
   if (checker.collides(end, c, sn, end_clearance)) return false;
   return sweep_to_free_end(checker, arc, start_clearance, distance, end_clearance);
 }
@@ -122,8 +136,15 @@ double free_prefix(const GridCollisionChecker& checker, const Arc& arc, double s
 bool arc_samples_free(const GridCollisionChecker& checker, const Pose2& from, double curvature, double distance,
                       double spacing) {
   const int n = std::max(1, static_cast<int>(std::ceil(std::abs(distance) / spacing)));
+  // One arc for all samples, and each sample's cos and sin of its heading from it (the values
+  // the checker would compute from the yaw): one sincos per sample instead of three.
+  const Arc arc(from, curvature);
   for (int i = n; i >= 1; --i) {  // the end first: it is the likeliest to collide
-    if (checker.collides(drive(from, curvature, distance * i / n))) return false;
+    double c = 1.0;
+    double sn = 0.0;
+    double bound = 0.0;
+    const Pose2 pose = arc.at(distance * i / n, c, sn);
+    if (checker.collides(pose, c, sn, bound)) return false;
   }
   return true;
 }

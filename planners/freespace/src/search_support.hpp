@@ -23,6 +23,7 @@ Pose2 drive(const Pose2& from, double curvature, double distance);
 class Arc {
  public:
   Arc(const Pose2& from, double curvature);
+  // cos_yaw, sin_yaw: std::cos and std::sin of from.yaw (the checker gets them from at()).
   Arc(const Pose2& from, double cos_yaw, double sin_yaw, double curvature);
   // The pose after `distance` [m] (negative: reverse), with cos and sin of its heading.
   Pose2 at(double distance, double& cos_yaw, double& sin_yaw) const;
@@ -48,6 +49,10 @@ class Arc {
 // 5.5 m from the turning centre): conservative by that much, never optimistic.
 bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
               double& end_clearance);
+// The same, also giving the end pose (arc.at(distance), the value the test used), so that a caller
+// does not drive the arc a second time.
+bool arc_free(const GridCollisionChecker& checker, const Arc& arc, double start_clearance, double distance,
+              double& end_clearance, Pose2& end);
 
 // The length [m] of a collision-free prefix of the arc ("drive until contact"), at least
 // `min_length`, or 0 when there is none: the motion is driven until a sample (a cell of body

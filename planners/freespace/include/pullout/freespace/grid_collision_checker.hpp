@@ -35,6 +35,9 @@ class GridCollisionChecker {
   // sagitta of its chord, and the chord lies in the hull: with margin >= the largest sagitta
   // (sweep_margin), a false answer proves the whole motion between a and b free.
   bool sweep_collides(const Pose2& a, const Pose2& b, double margin) const;
+  // The same with the cos and sin of both headings given (callers that already have them).
+  bool sweep_collides(const Pose2& a, double cos_a, double sin_a, const Pose2& b, double cos_b, double sin_b,
+                      double margin) const;
   // The largest sagitta [m] of a footprint point's path while the vehicle turns by `turn` [rad]
   // on an arc of curvature `curvature` [1/m] (0 on a straight line).
   double sweep_margin(double curvature, double turn) const;
