@@ -137,6 +137,26 @@ std::string why_no_path(const PlanningResult& r) {
   return "no path: " + r.stop_reason + (r.path.reasons.empty() ? "" : " / " + r.path.reasons.front());
 }
 
+// Plans `s` with `planner`; a path found must pass the oracles (`radius`: of the bend, for where
+// the path ends).
+PlanningResult plan_checked(const StartPlanner& planner, const Spot& s, const VehicleInfo& v, double margin,
+                            double radius = 0.0) {
+  const Street st = make_spot(s, v);
+  PlanningResult r = planner.plan(st.request, StopCondition());
+  if (r.outcome == PlanningResult::Outcome::kFound) {
+    const std::string verdict = check_path(r.path, st, v, margin, radius);
+    EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
+  }
+  return r;
+}
+
+// As plan_checked, and the spot must be left.
+void expect_leaves(const StartPlanner& planner, const Spot& s, const VehicleInfo& v, double margin,
+                   double radius = 0.0) {
+  const PlanningResult r = plan_checked(planner, s, v, margin, radius);
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
+}
+
 TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   const VehicleInfo v;
   const StartPlannerParameters p = shipped_without_freespace();
@@ -148,14 +168,9 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   int found_unclaimed = 0;
   int most_changes = 0;
   for (const Spot& s : family()) {
-    const Street st = make_spot(s, v);
-    const PlanningResult r = planner.plan(st.request, StopCondition());
+    const PlanningResult r = plan_checked(planner, s, v, margin);
     const bool found = r.outcome == PlanningResult::Outcome::kFound;
-    if (found) {
-      const std::string verdict = check_path(r.path, st, v, margin);
-      EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
-      most_changes = std::max(most_changes, direction_changes(r.path));
-    }
+    if (found) most_changes = std::max(most_changes, direction_changes(r.path));
     if (s.slack >= 1.0 && s.road_lanes == 2 && s.kerb >= 0.3) {
       ++expected;
       found_expected += found ? 1 : 0;
@@ -189,14 +204,8 @@ TEST(GeometricShunts, LeavesSingleLaneSpotsWithAGentlerExit) {
   for (bool right_hand : {true, false}) {
     for (double kerb : {0.3, 0.5}) {
       for (double slack : {3.0, 2.0, 1.5, 1.2, 1.0}) {
-        const Spot s{right_hand, 1, kerb, slack};
-        const Street st = make_spot(s, v);
-        const PlanningResult r = planner.plan(st.request, StopCondition());
+        expect_leaves(planner, {right_hand, 1, kerb, slack}, v, margin);
         ++spots;
-        EXPECT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
-        if (r.outcome != PlanningResult::Outcome::kFound) continue;
-        const std::string verdict = check_path(r.path, st, v, margin);
-        EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
       }
     }
   }
@@ -218,14 +227,8 @@ TEST(GeometricShunts, LeavesSpotsCloseToTheKerbByCreepingAwayFirst) {
   for (bool right_hand : {true, false}) {
     for (int road_lanes : {1, 2}) {
       for (double slack : {3.0, 2.0, 1.5, 1.0}) {
-        const Spot s{right_hand, road_lanes, 0.15, slack};
-        const Street st = make_spot(s, v);
-        const PlanningResult r = planner.plan(st.request, StopCondition());
+        expect_leaves(planner, {right_hand, road_lanes, 0.15, slack}, v, margin);
         ++spots;
-        EXPECT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
-        if (r.outcome != PlanningResult::Outcome::kFound) continue;
-        const std::string verdict = check_path(r.path, st, v, margin);
-        EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
       }
     }
   }
@@ -277,13 +280,8 @@ TEST(GeometricShunts, LeavesSpotsOnBendsWithAMetreOfSlack) {
     for (double radius : {30.0, 100.0}) {
       for (double kerb : {0.3, 0.5}) {
         for (double slack : {3.0, 2.0, 1.5, 1.0}) {
-          const Spot s{right_hand, 2, kerb, slack, radius};
-          const Street st = make_spot(s, v);
-          const PlanningResult r = planner.plan(st.request, StopCondition());
+          expect_leaves(planner, {right_hand, 2, kerb, slack, radius}, v, margin, radius);
           ++spots;
-          ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
-          const std::string verdict = check_path(r.path, st, v, margin, radius);
-          EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
         }
       }
     }

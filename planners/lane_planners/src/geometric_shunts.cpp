@@ -219,19 +219,7 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
   // The room [m] beside the kerb side of lane_fp at q, up to kCreepTarget (bisection).
   double creep_target = 0.0;  // [m] 0: no creeping
   const auto kerb_room = [&](const Pose2& q) {
-    const auto inside = [&](double e) {
-      Footprint f = lane_fp;
-      f.*kerb_side += e;
-      return ctx.world.footprint_inside(footprint_corners(f, q));
-    };
-    if (inside(creep_target)) return creep_target;
-    double lo = 0.0;
-    double hi = creep_target;
-    for (int i = 0; i < kEndBisections; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (inside(mid) ? lo : hi) = mid;
-    }
-    return lo;
+    return std::max(0.0, side_clearance(ctx.world, lane_fp, kerb_side, q, creep_target, kEndBisections));
   };
   const double move_cap = kMaxMoveTurn / kappa;
   std::optional<PathCandidate> exit;
