@@ -7,14 +7,14 @@
 // What a driver does, as the target: every spot with 1.0 m or more of slack is left. Claimed here
 // (what the shunting manoeuvre reaches today): two road lanes, 0.3 m or more from the kerb, 1.0 m
 // or more of slack; and in the tests below, 0.15 m from the kerb (straight) and a single road lane
-// with 1.0 m or more. Not claimed: single road lanes on bends at 1.0 m, 0.8 m of slack; printed. Every path
-// found is checked by oracles written independently of the planners (path_oracles.hpp and plain
-// geometry here): at poses interpolated every 5 cm along every partial path, the bare body
-// inside the raw lane polygons and at least the smallest collision margin (less the chord
-// tolerance) from both cars' rectangles; each partial path drives one way; velocity 0 at the end
-// of every partial path followed by one driving the other way; consecutive partial paths join
-// (within 1 cm, same heading); one pair per partial path; the path ends on the road lane's
-// centerline, parallel to it.
+// with 1.0 m or more (straight and on the 30 m bend). Not claimed: single road lanes on the 100 and
+// 200 m bends, 0.8 m of slack; printed. Every path found is checked by oracles written
+// independently of the planners (path_oracles.hpp and plain geometry here): at poses interpolated
+// every 5 cm along every partial path, the bare body inside the raw lane polygons and at least the
+// smallest collision margin (less the chord tolerance) from both cars' rectangles; each partial
+// path drives one way; velocity 0 at the end of every partial path followed by one driving the
+// other way; consecutive partial paths join (within 1 cm, same heading); one pair per partial path;
+// the path ends on the road lane's centerline, parallel to it.
 //
 // And where nobody gets out, a clear no-path: less slack than twice the smallest margin (the
 // start already has the cars closer than that), and a spot whose road is blocked beyond it.
@@ -287,6 +287,29 @@ TEST(GeometricShunts, LeavesSpotsOnBendsWithAMetreOfSlack) {
     }
   }
   EXPECT_EQ(spots, 32);
+}
+
+// One road lane on the 30 m bend, 1.0 m of slack, 0.15-0.5 m from the kerb, with the parking lane
+// inside the bend (left-hand traffic) and outside it (right-hand): every spot is left, every path
+// passes the oracles. The shunts of up to 22.5 degrees each try the exit only every 35-40 degrees
+// of turn here (a forward and a reverse move), and the turns that pass the car ahead with the
+// smallest margin and those whose exit still fits the one lane lie in between (right-hand, 0.5 m:
+// at 31 degrees the best exit passes the car ahead 0.06 m off, at 71 degrees every exit leaves the
+// lane); moves of 5 degrees, then 3, find them. Before those, four of these six spots had no path
+// by the lane planners (left-hand 0.15, 0.3 and 0.5 m, right-hand 0.5 m), and two by any planner.
+TEST(GeometricShunts, LeavesSingleLaneSpotsOnATightBendInSmallSteps) {
+  const VehicleInfo v;
+  const StartPlannerParameters p = shipped_without_freespace();
+  const StartPlanner planner(v, p);
+  const double margin = smallest_margin(p);
+  int spots = 0;
+  for (bool right_hand : {true, false}) {
+    for (double kerb : {0.15, 0.3, 0.5}) {
+      expect_leaves(planner, {right_hand, 1, kerb, 1.0, 30.0}, v, margin, 30.0);
+      ++spots;
+    }
+  }
+  EXPECT_EQ(spots, 6);
 }
 
 // The same spots with shunting off: the tight ones are not left (what the shunts add), so the
