@@ -118,6 +118,9 @@ int main(int argc, char** argv) {
     StartPlannerParameters p;
     p.collision_check_margin_from_front_object = 0.0;
     p.freespace_planner.time_limit = 1000.0;
+    // PULLOUT_BENCH_FS_MS=N: the freespace budget N ms instead (does the fallback find a path with
+    // more time?).
+    if (const char* ms = std::getenv("PULLOUT_BENCH_FS_MS")) p.freespace_planner.time_limit = std::atof(ms);
     if (k == 0) p.search_priority = {PlannerType::kShift};
     if (k == 1 || k == 2) p.search_priority = {PlannerType::kGeometric};
     if (k == 1) p.geometric_pull_out_max_shunts = 0;

@@ -7,14 +7,14 @@
 // What a driver does, as the target: every spot with 1.0 m or more of slack is left. Claimed here
 // (what the shunting manoeuvre reaches today): two road lanes, 0.3 m or more from the kerb, 1.0 m
 // or more of slack; and in the tests below, 0.15 m from the kerb (straight) and a single road lane
-// with 1.0 m or more. Not claimed: single road lanes on bends at 1.0 m, 0.8 m of slack; printed. Every path
-// found is checked by oracles written independently of the planners (path_oracles.hpp and plain
-// geometry here): at poses interpolated every 5 cm along every partial path, the bare body
-// inside the raw lane polygons and at least the smallest collision margin (less the chord
-// tolerance) from both cars' rectangles; each partial path drives one way; velocity 0 at the end
-// of every partial path followed by one driving the other way; consecutive partial paths join
-// (within 1 cm, same heading); one pair per partial path; the path ends on the road lane's
-// centerline, parallel to it.
+// with 1.0 m or more (straight and on the 30 m bend). Not claimed: single road lanes on the 100 and
+// 200 m bends, 0.8 m of slack; printed. Every path found is checked by oracles written
+// independently of the planners (path_oracles.hpp and plain geometry here): at poses interpolated
+// every 5 cm along every partial path, the bare body inside the raw lane polygons and at least the
+// smallest collision margin (less the chord tolerance) from both cars' rectangles; each partial
+// path drives one way; velocity 0 at the end of every partial path followed by one driving the
+// other way; consecutive partial paths join (within 1 cm, same heading); one pair per partial path;
+// the path ends on the road lane's centerline, parallel to it.
 //
 // And where nobody gets out, a clear no-path: less slack than twice the smallest margin (the
 // start already has the cars closer than that), and a spot whose road is blocked beyond it.
@@ -137,6 +137,26 @@ std::string why_no_path(const PlanningResult& r) {
   return "no path: " + r.stop_reason + (r.path.reasons.empty() ? "" : " / " + r.path.reasons.front());
 }
 
+// Plans `s` with `planner`; a path found must pass the oracles (`radius`: of the bend, for where
+// the path ends).
+PlanningResult plan_checked(const StartPlanner& planner, const Spot& s, const VehicleInfo& v, double margin,
+                            double radius = 0.0) {
+  const Street st = make_spot(s, v);
+  PlanningResult r = planner.plan(st.request, StopCondition());
+  if (r.outcome == PlanningResult::Outcome::kFound) {
+    const std::string verdict = check_path(r.path, st, v, margin, radius);
+    EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
+  }
+  return r;
+}
+
+// As plan_checked, and the spot must be left.
+void expect_leaves(const StartPlanner& planner, const Spot& s, const VehicleInfo& v, double margin,
+                   double radius = 0.0) {
+  const PlanningResult r = plan_checked(planner, s, v, margin, radius);
+  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
+}
+
 TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   const VehicleInfo v;
   const StartPlannerParameters p = shipped_without_freespace();
@@ -148,14 +168,9 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   int found_unclaimed = 0;
   int most_changes = 0;
   for (const Spot& s : family()) {
-    const Street st = make_spot(s, v);
-    const PlanningResult r = planner.plan(st.request, StopCondition());
+    const PlanningResult r = plan_checked(planner, s, v, margin);
     const bool found = r.outcome == PlanningResult::Outcome::kFound;
-    if (found) {
-      const std::string verdict = check_path(r.path, st, v, margin);
-      EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
-      most_changes = std::max(most_changes, direction_changes(r.path));
-    }
+    if (found) most_changes = std::max(most_changes, direction_changes(r.path));
     if (s.slack >= 1.0 && s.road_lanes == 2 && s.kerb >= 0.3) {
       ++expected;
       found_expected += found ? 1 : 0;
@@ -189,14 +204,8 @@ TEST(GeometricShunts, LeavesSingleLaneSpotsWithAGentlerExit) {
   for (bool right_hand : {true, false}) {
     for (double kerb : {0.3, 0.5}) {
       for (double slack : {3.0, 2.0, 1.5, 1.2, 1.0}) {
-        const Spot s{right_hand, 1, kerb, slack};
-        const Street st = make_spot(s, v);
-        const PlanningResult r = planner.plan(st.request, StopCondition());
+        expect_leaves(planner, {right_hand, 1, kerb, slack}, v, margin);
         ++spots;
-        EXPECT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
-        if (r.outcome != PlanningResult::Outcome::kFound) continue;
-        const std::string verdict = check_path(r.path, st, v, margin);
-        EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
       }
     }
   }
@@ -218,14 +227,8 @@ TEST(GeometricShunts, LeavesSpotsCloseToTheKerbByCreepingAwayFirst) {
   for (bool right_hand : {true, false}) {
     for (int road_lanes : {1, 2}) {
       for (double slack : {3.0, 2.0, 1.5, 1.0}) {
-        const Spot s{right_hand, road_lanes, 0.15, slack};
-        const Street st = make_spot(s, v);
-        const PlanningResult r = planner.plan(st.request, StopCondition());
+        expect_leaves(planner, {right_hand, road_lanes, 0.15, slack}, v, margin);
         ++spots;
-        EXPECT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
-        if (r.outcome != PlanningResult::Outcome::kFound) continue;
-        const std::string verdict = check_path(r.path, st, v, margin);
-        EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
       }
     }
   }
@@ -277,18 +280,36 @@ TEST(GeometricShunts, LeavesSpotsOnBendsWithAMetreOfSlack) {
     for (double radius : {30.0, 100.0}) {
       for (double kerb : {0.3, 0.5}) {
         for (double slack : {3.0, 2.0, 1.5, 1.0}) {
-          const Spot s{right_hand, 2, kerb, slack, radius};
-          const Street st = make_spot(s, v);
-          const PlanningResult r = planner.plan(st.request, StopCondition());
+          expect_leaves(planner, {right_hand, 2, kerb, slack, radius}, v, margin, radius);
           ++spots;
-          ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << s << ": " << why_no_path(r);
-          const std::string verdict = check_path(r.path, st, v, margin, radius);
-          EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
         }
       }
     }
   }
   EXPECT_EQ(spots, 32);
+}
+
+// One road lane on the 30 m bend, 1.0 m of slack, 0.15-0.5 m from the kerb, with the parking lane
+// inside the bend (left-hand traffic) and outside it (right-hand): every spot is left, every path
+// passes the oracles. The shunts of up to 22.5 degrees each try the exit only every 35-40 degrees
+// of turn here (a forward and a reverse move), and the turns that pass the car ahead with the
+// smallest margin and those whose exit still fits the one lane lie in between (right-hand, 0.5 m:
+// at 31 degrees the best exit passes the car ahead 0.06 m off, at 71 degrees every exit leaves the
+// lane); moves of 5 degrees, then 3, find them. Before those, four of these six spots had no path
+// by the lane planners (left-hand 0.15, 0.3 and 0.5 m, right-hand 0.5 m), and two by any planner.
+TEST(GeometricShunts, LeavesSingleLaneSpotsOnATightBendInSmallSteps) {
+  const VehicleInfo v;
+  const StartPlannerParameters p = shipped_without_freespace();
+  const StartPlanner planner(v, p);
+  const double margin = smallest_margin(p);
+  int spots = 0;
+  for (bool right_hand : {true, false}) {
+    for (double kerb : {0.15, 0.3, 0.5}) {
+      expect_leaves(planner, {right_hand, 1, kerb, 1.0, 30.0}, v, margin, 30.0);
+      ++spots;
+    }
+  }
+  EXPECT_EQ(spots, 6);
 }
 
 // The same spots with shunting off: the tight ones are not left (what the shunts add), so the

@@ -27,6 +27,13 @@ inline double corner_swing(double r, double along, double across, double turn, d
   return (turn >= peak - tilt ? radius : radius * std::cos(turn + tilt - peak)) - at_start;
 }
 
+// The largest expansion [m], up to `cap`, of the side `side` of `base` with which the footprint at
+// `pose` stays inside the lanes, by `bisections` halvings of [0, cap]; -1 when `base` itself does
+// not. Shared by the S's lane-check footprint (the room at the front, the rear and the kerb side)
+// and the shunts' creeping (the room on the kerb side).
+double side_clearance(const LaneWorld& world, const Footprint& base, double Footprint::*side, const Pose2& pose,
+                      double cap, int bisections);
+
 // The S candidates from `start` (see geometric_pull_out.hpp), tightest end pose first. With a
 // finite `usable_margin` [m] the search ends at the first candidate usable at that margin (no
 // rejection, clearance >= usable_margin); +inf: every candidate. With `turn_paths`, the arcs of

@@ -63,10 +63,10 @@ double distance_to_lane_edge(const Edges& edges, const Vec2& p, const Vec2& dir)
   return best;
 }
 
-// The largest expansion [m], up to `cap`, of the side `side` of `base` with which the footprint
-// at `pose` stays inside the lanes (bisection); -1 when `base` itself does not.
+}  // namespace
+
 double side_clearance(const LaneWorld& world, const Footprint& base, double Footprint::*side, const Pose2& pose,
-                      double cap) {
+                      double cap, int bisections) {
   const auto inside = [&](double e) {
     Footprint f = base;
     f.*side += e;
@@ -76,14 +76,12 @@ double side_clearance(const LaneWorld& world, const Footprint& base, double Foot
   if (inside(cap)) return cap;
   double lo = 0.0;
   double hi = cap;
-  for (int i = 0; i < kClearanceBisections; ++i) {
+  for (int i = 0; i < bisections; ++i) {
     const double mid = 0.5 * (lo + hi);
     (inside(mid) ? lo : hi) = mid;
   }
   return lo;
 }
-
-}  // namespace
 
 PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& start, const StopCondition& stop,
                                       double usable_margin, std::vector<CurvaturePath>* turn_paths,
@@ -116,11 +114,12 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
   double Footprint::*const road_side = side > 0.0 ? &Footprint::left : &Footprint::right;
   double Footprint::*const kerb_side = side > 0.0 ? &Footprint::right : &Footprint::left;
   Footprint fp = plain;
-  fp.front += std::max(0.0, side_clearance(ctx.world, plain, &Footprint::front, start, margin));
-  fp.rear += std::max(0.0, side_clearance(ctx.world, plain, &Footprint::rear, start, margin));
+  fp.front += std::max(0.0, side_clearance(ctx.world, plain, &Footprint::front, start, margin, kClearanceBisections));
+  fp.rear += std::max(0.0, side_clearance(ctx.world, plain, &Footprint::rear, start, margin, kClearanceBisections));
   // Room beside the kerb side at the start (with the front and rear margins: the corners count).
   const double kerb_cap = margin + kKerbReach;
-  const double kerb_gap = std::max(0.0, side_clearance(ctx.world, fp, kerb_side, start, kerb_cap));
+  const double kerb_gap =
+      std::max(0.0, side_clearance(ctx.world, fp, kerb_side, start, kerb_cap, kClearanceBisections));
   const double swing_at_r_min = corner_swing(r_min, fp.rear, plain.*kerb_side, kPi, tilt);
   const double kerb_margin = std::clamp(kerb_gap - swing_at_r_min - kSwingSlack, kerb_floor, margin);
   fp.*road_side += margin;

@@ -1,6 +1,7 @@
 // The geometric planner's shunting manoeuvre (see geometric_pull_out.hpp): moves at full lock,
 // alternating forward and reverse, each until just clear, then the S.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -32,6 +33,14 @@ constexpr double kLaneSlack = 0.01;  // [m] footprint growth of the moves' lane 
 // turned further than kMaxTilt from the road is not leaving a parallel spot any more.
 constexpr double kMaxMoveTurn = kPi / 8.0;
 constexpr double kMaxTilt = kPi / 2.0;
+// [rad] Where every try got turned across the road, the moves of the last tries turn at most
+// this much (5, then 3 degrees): a forward and a reverse move of kMaxMoveTurn turn the vehicle by
+// 35-40 degrees between two tries of the exit, and on one road lane round a 30 m bend the turns
+// whose exit passes the car ahead with the smallest margin and still fits the lane lie in between
+// (right-hand, 0.5 m from the kerb: 0.06 m from the car ahead at 31 degrees, over the far edge at
+// 71). Which of the two sizes leaves a spot differs from spot to spot (both stop after
+// geometric_pull_out_max_shunts), so both are tried.
+constexpr std::array<double, 2> kFineMoveTurns{kPi / 36.0, kPi / 60.0};
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kOutputInterval = 0.1;  // [m] points of a move: chords within 0.3 mm of a 5 m arc
 // [m] Creeping away from the kerb (see plan_multi_move) goes on until the lane check's footprint
@@ -219,27 +228,41 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
   // The room [m] beside the kerb side of lane_fp at q, up to kCreepTarget (bisection).
   double creep_target = 0.0;  // [m] 0: no creeping
   const auto kerb_room = [&](const Pose2& q) {
-    const auto inside = [&](double e) {
-      Footprint f = lane_fp;
-      f.*kerb_side += e;
-      return ctx.world.footprint_inside(footprint_corners(f, q));
-    };
-    if (inside(creep_target)) return creep_target;
-    double lo = 0.0;
-    double hi = creep_target;
-    for (int i = 0; i < kEndBisections; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (inside(mid) ? lo : hi) = mid;
-    }
-    return lo;
+    return std::max(0.0, side_clearance(ctx.world, lane_fp, kerb_side, q, creep_target, kEndBisections));
   };
-  const double move_cap = kMaxMoveTurn / kappa;
+  double move_cap = kMaxMoveTurn / kappa;
   std::optional<PathCandidate> exit;
   std::string stuck;
   // The manoeuvre; with `creep`, first edge away from the kerb (see kCreepTarget). False when it
   // got stuck (`stuck` says where).
-  const auto manoeuvre = [&](double target) {
+  const auto try_exit = [&]() {
+    // 1. The S from here.
+    // The candidates in order up to the first usable one (the rest are not needed when its dense
+    // check passes); all of them only where it does not: the same exit as taking all at once.
+    for (const double usable : {ctx.smallest_margin, kInfinity}) {
+      std::vector<CurvaturePath> turn_paths;
+      PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, usable, &turn_paths, moves.size() > 1);
+      bool usable_found = false;
+      for (std::size_t i = 0; i < s.candidates.size(); ++i) {
+        PathCandidate& c = s.candidates[i];
+        if (c.rejection || c.clearance < ctx.smallest_margin) continue;
+        usable_found = true;
+        // The S's own clearance samples every 0.5 m and refines around minima; from a tilted
+        // start the corners pass the cars within centimetres of the start, so it is taken
+        // densely here.
+        const CurvaturePath& turns = turn_paths[i];
+        const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kDenseSlack);
+        if (dense.distance < ctx.smallest_margin + kDenseSlack) continue;
+        exit = std::move(c);
+        break;
+      }
+      // Without a usable candidate the first call has looked at all of them.
+      if (exit || !usable_found) break;
+    }
+  };
+  const auto manoeuvre = [&](double target, double turn) {
     creep_target = target;
+    move_cap = turn / kappa;
     moves.clear();
     pose = start;
     exit.reset();
@@ -268,29 +291,7 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
     for (int shunt = 0;; ++shunt) {
       out.stopped = stop.check();
       if (out.stopped != StopReason::kNone) return false;
-      // 1. The S from here.
-      // The candidates in order up to the first usable one (the rest are not needed when its dense
-      // check passes); all of them only where it does not: the same exit as taking all at once.
-      for (const double usable : {ctx.smallest_margin, kInfinity}) {
-        std::vector<CurvaturePath> turn_paths;
-        PlannerCandidates s = arc_pair_candidates(ctx, pose, stop, usable, &turn_paths, moves.size() > 1);
-        bool usable_found = false;
-        for (std::size_t i = 0; i < s.candidates.size(); ++i) {
-          PathCandidate& c = s.candidates[i];
-          if (c.rejection || c.clearance < ctx.smallest_margin) continue;
-          usable_found = true;
-          // The S's own clearance samples every 0.5 m and refines around minima; from a tilted
-          // start the corners pass the cars within centimetres of the start, so it is taken
-          // densely here.
-          const CurvaturePath& turns = turn_paths[i];
-          const auto dense = dense_clearance(ctx, turns, turns.length(), ctx.smallest_margin + kDenseSlack);
-          if (dense.distance < ctx.smallest_margin + kDenseSlack) continue;
-          exit = std::move(c);
-          break;
-        }
-        // Without a usable candidate the first call has looked at all of them.
-        if (exit || !usable_found) break;
-      }
+      try_exit();
       if (exit) break;
       if (shunt >= p.geometric_pull_out_max_shunts) {
         stuck = "no S onto the road after " + std::to_string(shunt) + " shunts";
@@ -321,21 +322,36 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
   // first there, and only then try without.
   creep_target = kCreepTarget;
   const bool close = kerb_room(start) < kCreepFirst;
-  std::vector<double> tries;
+  struct Try {
+    double creep;  // [m] creep_target
+    double turn;   // [rad] of a move at most
+  };
+  std::vector<Try> tries;
   if (close) {
-    tries = {kCreepTarget, 0.0, kCreepFar};
+    tries = {{kCreepTarget, kMaxMoveTurn}, {0.0, kMaxMoveTurn}, {kCreepFar, kMaxMoveTurn}};
   } else {
-    tries = {0.0, kCreepTarget, kCreepFar};
+    tries = {{0.0, kMaxMoveTurn}, {kCreepTarget, kMaxMoveTurn}, {kCreepFar, kMaxMoveTurn}};
+  }
+  for (const double fine : kFineMoveTurns) {
+    tries.push_back({0.0, fine});
+    tries.push_back({kCreepFar, fine});
   }
   std::string why;
+  bool turned_across = false;
   for (std::size_t t = 0; t < tries.size(); ++t) {
     // Without creeping first, creeping to kCreepTarget helps only where the rear corner got stuck.
     if (!close && t == 1 && stuck.rfind("no room to reverse", 0) != 0) continue;
-    const bool left = manoeuvre(tries[t]);
+    if (tries[t].turn < kMaxMoveTurn && !turned_across) break;
+    const bool left = manoeuvre(tries[t].creep, tries[t].turn);
     if (out.stopped != StopReason::kNone) return out;
     if (left) break;
+    turned_across = turned_across || stuck.rfind("turned across", 0) == 0;
     why += (why.empty() ? "" : "; ") +
-           (tries[t] > 0.0 ? "after creeping to " + std::to_string(tries[t]).substr(0, 3) + " m: " : std::string()) +
+           (tries[t].turn < kMaxMoveTurn
+                ? "moves of " + std::to_string(static_cast<int>(std::lround(tries[t].turn * 180.0 / kPi))) + " deg, "
+                : std::string()) +
+           (tries[t].creep > 0.0 ? "after creeping to " + std::to_string(tries[t].creep).substr(0, 3) + " m: "
+                                 : std::string()) +
            stuck;
   }
   stuck = why;

@@ -73,7 +73,11 @@
 //   otherwise: "turned across the road" on a single road lane), once more creeping to 0.6 m of
 //   room: from further out less turn passes the car ahead, and the exit then fits the lane. A start
 //   with less than 0.2 m of room on the kerb side creeps first (the shunts without get stuck
-//   there almost always), then tries without, then creeps to 0.6 m.
+//   there almost always), then tries without, then creeps to 0.6 m. Where one of those got stuck
+//   turned across the road, last without creeping and with creeping to 0.6 m, with moves of at
+//   most 5 degrees, then 3 degrees (the exit is tried after every reverse move: large moves can
+//   turn the vehicle past the few turns whose exit both clears the car ahead and fits a single
+//   lane round a tight bend).
 // "Just clear": every pose of a move keeps the footprint (expanded by
 // lane_departure_check_expansion_margin, and 1 cm) inside the lanes and at least the smallest
 // collision margin plus 2 cm from every static obstacle (sampled every 2 cm at most and bisected
