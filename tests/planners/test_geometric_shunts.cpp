@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "../sampling.hpp"
 #include "path_oracles.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/start_planner.hpp"
@@ -167,12 +168,16 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
   int unclaimed = 0;
   int found_unclaimed = 0;
   int most_changes = 0;
-  for (const Spot& s : family()) {
+  const std::vector<Spot> spots = family();
+  for (std::size_t i = 0; i < spots.size(); ++i) {
+    const Spot& s = spots[i];
+    const bool claimed = s.slack >= 1.0 && s.road_lanes == 2 && s.kerb >= 0.3;
+    expected += claimed ? 1 : 0;
+    if (!test::sampled(i)) continue;
     const PlanningResult r = plan_checked(planner, s, v, margin);
     const bool found = r.outcome == PlanningResult::Outcome::kFound;
     if (found) most_changes = std::max(most_changes, direction_changes(r.path));
-    if (s.slack >= 1.0 && s.road_lanes == 2 && s.kerb >= 0.3) {
-      ++expected;
+    if (claimed) {
       found_expected += found ? 1 : 0;
       EXPECT_TRUE(found) << s << ": " << why_no_path(r);
     } else {
@@ -184,7 +189,7 @@ TEST(GeometricShunts, LeavesEveryParallelSpotWithAMetreOfSlack) {
             << unclaimed << " of the others; at most " << most_changes << " direction changes\n";
   EXPECT_EQ(expected, 20);
   // The family exercises multi-move paths (reverse, forward, reverse, forward: 3 changes and more).
-  EXPECT_GE(most_changes, 3);
+  if (!test::kUnderSanitizer) EXPECT_GE(most_changes, 3);
 }
 
 // One road lane (a one-way street: no opposite lane to swing into), straight, 0.3 and 0.5 m from
@@ -204,7 +209,8 @@ TEST(GeometricShunts, LeavesSingleLaneSpotsWithAGentlerExit) {
   for (bool right_hand : {true, false}) {
     for (double kerb : {0.3, 0.5}) {
       for (double slack : {3.0, 2.0, 1.5, 1.2, 1.0}) {
-        expect_leaves(planner, {right_hand, 1, kerb, slack}, v, margin);
+        if (test::sampled(static_cast<std::size_t>(spots)))
+          expect_leaves(planner, {right_hand, 1, kerb, slack}, v, margin);
         ++spots;
       }
     }
@@ -227,7 +233,8 @@ TEST(GeometricShunts, LeavesSpotsCloseToTheKerbByCreepingAwayFirst) {
   for (bool right_hand : {true, false}) {
     for (int road_lanes : {1, 2}) {
       for (double slack : {3.0, 2.0, 1.5, 1.0}) {
-        expect_leaves(planner, {right_hand, road_lanes, 0.15, slack}, v, margin);
+        if (test::sampled(static_cast<std::size_t>(spots)))
+          expect_leaves(planner, {right_hand, road_lanes, 0.15, slack}, v, margin);
         ++spots;
       }
     }
@@ -280,7 +287,8 @@ TEST(GeometricShunts, LeavesSpotsOnBendsWithAMetreOfSlack) {
     for (double radius : {30.0, 100.0}) {
       for (double kerb : {0.3, 0.5}) {
         for (double slack : {3.0, 2.0, 1.5, 1.0}) {
-          expect_leaves(planner, {right_hand, 2, kerb, slack, radius}, v, margin, radius);
+          if (test::sampled(static_cast<std::size_t>(spots)))
+            expect_leaves(planner, {right_hand, 2, kerb, slack, radius}, v, margin, radius);
           ++spots;
         }
       }
