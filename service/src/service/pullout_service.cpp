@@ -481,8 +481,17 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
     spdlog::info("vehicle '{}' request {}: received (route of {} lanelets, {} objects)", request.vehicle_id,
                  request.request_id, request.route_lanelet_ids.size(), request.objects.size());
   }
-  std::optional<PlanningJob> job = registry_.on_request(std::move(request), {});
+  // Planned here first when it is quick: a hand-off to a planning thread costs a wake-up and a
+  // context switch per request, and on a busy machine a wait for the woken thread to be scheduled;
+  // the `planning` status that would precede a quick answer by a millisecond costs a DDS write.
+  // Not in replica mode: there a vehicle's `planning` status is what the other replicas see first.
+  const bool plan_here = config_.service.inline_planning_ms > 0.0 && !shadows_;
+  std::optional<PlanningJob> job = registry_.on_request(std::move(request), {}, plan_here);
   if (!job) return;  // rejected, or only the objects of the followed path updated
+  if (plan_here) {
+    if (plan_inline(*job)) return;
+    registry_.release_planning(*job);
+  }
   const std::string vehicle = job->request.vehicle_id;
   if (queue_->push(std::move(*job))) {
     spdlog::debug("vehicle '{}': a waiting request was replaced by a newer one", vehicle);
@@ -505,6 +514,26 @@ void PulloutService::handle_progress(const msg::ExecutionProgress& sample) {
   registry_.on_progress(progress);
 }
 
+bool PulloutService::plan_inline(PlanningJob& job) {
+  const double budget_ms = effective_deadline_ms(job.request.deadline_ms);
+  const double inline_ms = config_.service.inline_planning_ms;
+  const bool whole_budget = budget_ms <= inline_ms;
+  const StopCondition stop =
+      StopCondition::after_ms(whole_budget ? budget_ms : inline_ms).with_cancel(job.cancel.get());
+  PlanningResult result;
+  try {
+    result = planner_.plan(job.request, stop, job.previous_world.get());
+  } catch (const std::exception&) {
+    return false;  // the planning thread runs it again and reports the failure
+  }
+  if (stopping_) return true;  // a search cut short by shutdown is not a "no path"
+  // Cut short by the inline budget (not the request's): the planning thread searches again with
+  // the whole budget, from the start (a stopped search keeps nothing).
+  if (!whole_budget && result.stopped != StopReason::kNone) return false;
+  finish(job, result, 0.0);
+  return true;
+}
+
 void PulloutService::run_job(PlanningJob& job) {
   const PullOutRequest& request = job.request;
   if (stopping_ || job.cancel->load()) return;  // superseded or shutting down before it started
@@ -522,6 +551,11 @@ void PulloutService::run_job(PlanningJob& job) {
     return;
   }
   if (stopping_) return;  // a search cut short by shutdown is not a "no path"
+  finish(job, result, waited_ms);
+}
+
+void PulloutService::finish(const PlanningJob& job, const PlanningResult& result, double waited_ms) {
+  const PullOutRequest& request = job.request;
   registry_.on_result(job, result);
   if (result.outcome == PlanningResult::Outcome::kFound) {
     spdlog::info("vehicle '{}' request {}: {} path, {} segment(s), {:.1f} ms (+{:.1f} ms queued)", request.vehicle_id,

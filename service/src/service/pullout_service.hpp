@@ -1,7 +1,9 @@
 // The pullout service: DDS in and out, a dispatcher thread and a pool of planning threads.
 //
 //   DDS readers --(WaitSet: DATA_AVAILABLE / shutdown guard)--> dispatcher thread
-//     request  -> convert + check -> kRejected, or kPlanning + per-vehicle job -> planning workers
+//     request  -> convert + check -> kRejected, or planned on the dispatcher when quick
+//                 (service.inline_planning_ms: path + status, no kPlanning), else
+//                 kPlanning + per-vehicle job -> planning workers
 //     progress -> convert + check -> the vehicle's execution tracker -> status on change
 //   planning worker -> StartPlanner::plan(request, deadline) -> path + status
 //
@@ -94,6 +96,11 @@ class PulloutService {
   void handle_request(const msg::PullOutRequest& sample);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
+  // Dispatcher: plans the job itself within service.inline_planning_ms and publishes the result.
+  // False when the search needs longer (or threw): the job is for a planning thread then.
+  bool plan_inline(PlanningJob& job);
+  // A search's result to the registry (published unless a newer request came), and the log.
+  void finish(const PlanningJob& job, const PlanningResult& result, double waited_ms);
   // service.state_dir: every vehicle of the journal restored (before the dispatcher starts).
   void restore_from_journal();
   // A snapshot's session rebuilt in the registry, its search (if any) queued.

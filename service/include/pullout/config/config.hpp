@@ -64,6 +64,10 @@ struct ReplicaConfig {
 struct ServiceConfig {
   int worker_threads{2};
   double default_deadline_ms{200.0};  // [ms]
+  // [ms] The dispatcher plans a request itself for up to this long (its own thread, no hand-off,
+  // no `planning` status: the answer is the first sample); a search that needs longer is handed to
+  // a planning thread, with `planning`, and run again there (0: every request handed off).
+  double inline_planning_ms{2.0};
   RequestLimits limits;
   std::string log_level{"info"};  // one of kLogLevels
   // [s] A departed vehicle with no progress sample for this long is told to stop (0: never).
