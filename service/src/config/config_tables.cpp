@@ -441,8 +441,8 @@ const Table<ServiceConfig>& service_table() {
       field("default_deadline_ms", &T::default_deadline_ms, "ms", above(0.0),
             "planning budget when a request gives none, <= limits.max_deadline_ms"),
       field("inline_planning_ms", &T::inline_planning_ms, "ms", in(0.0, 50.0),
-            "the dispatcher plans a request itself up to this long (answer without a `planning` status); longer "
-            "searches go to a planning thread; 0 = always a planning thread"),
+            "the dispatcher plans a request itself up to this long while it keeps up (answer without a "
+            "`planning` status); longer searches go to a planning thread; 0 = always a planning thread"),
       field("log_level", &T::log_level, "", Choices{{kLogLevels.begin(), kLogLevels.end()}}, ""),
       field("progress_timeout_s", &T::progress_timeout_s, "s", in(0.0, 60.0),
             "a departed vehicle silent this long is told to stop (odometry lost); 0 = never"),

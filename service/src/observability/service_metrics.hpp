@@ -60,6 +60,10 @@ class ServiceMetrics {
   void set_vehicles(std::size_t n);
   void set_queue_depth(std::size_t n);
   void set_other_services(std::size_t n);
+  // Where a search ran: on the dispatcher within service.inline_planning_ms, or on a planning
+  // thread (handed off at once, or after the inline attempt ran out of time).
+  void on_search_inline();
+  void on_search_handed_off(bool after_inline_attempt);
 
   // Distinct rejection field classes kept as labels; the rest count as "other" (a label per
   // distinct value is a time series for ever).
@@ -70,6 +74,9 @@ class ServiceMetrics {
 
   std::shared_ptr<prometheus::Registry> registry_;
   prometheus::Counter* requests_{nullptr};
+  prometheus::Counter* searched_inline_{nullptr};
+  prometheus::Counter* handed_off_{nullptr};
+  prometheus::Counter* handed_off_after_inline_{nullptr};
   prometheus::Counter* found_{nullptr};
   prometheus::Counter* no_path_{nullptr};
   prometheus::Counter* rejected_{nullptr};

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <exception>
 #include <iterator>
 #include <mutex>
@@ -44,6 +45,27 @@ const char* outcome_name(PlanningResult::Outcome o) {
       return "rejected";
   }
   return "?";
+}
+
+// [ms] A request that waited longer than this in the reader is handed to a planning thread, not
+// planned on the dispatcher: the dispatcher is behind (a burst, or a machine short of CPU).
+constexpr double kInlineMaxWaitMs = 5.0;
+
+// [ms] How long ago Fast DDS received the sample (both stamps on this host's system clock); 0 when
+// the stamp is missing or in the future.
+double waited_in_reader_ms(const dds::SampleInfo& info) {
+  const eprosima::fastrtps::rtps::Time_t& r = info.reception_timestamp;
+  const double received_ms = static_cast<double>(r.seconds()) * 1e3 + static_cast<double>(r.nanosec()) / 1e6;
+  const double now_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return received_ms > 0.0 && now_ms > received_ms ? now_ms - received_ms : 0.0;
+}
+
+// [ms] CPU time of the calling thread.
+double thread_cpu_ms() {
+  timespec t{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) / 1e6;
 }
 
 RegistryOptions registry_options(const ServiceConfig& service, ServiceMetrics* metrics) {
@@ -255,7 +277,7 @@ void PulloutService::take_requests() {
           }
           continue;
         }
-        handle_request(sample);
+        handle_request(sample, waited_in_reader_ms(info));
       } else {
         instance_gone(request_instances_, info, VehicleInput::kRequest);
       }
@@ -457,7 +479,7 @@ void PulloutService::instance_gone(InstanceNames& names, const dds::SampleInfo& 
   names.erase(it);
 }
 
-void PulloutService::handle_request(const msg::PullOutRequest& sample) {
+void PulloutService::handle_request(const msg::PullOutRequest& sample, double waited_ms) {
   if (metrics_) metrics_->on_request();
   if (sample.vehicle_id().size() > kMaxVehicleIdBytes) {
     spdlog::warn("request {} dropped: vehicle_id of {} bytes cannot be answered (at most {})", sample.request_id(),
@@ -485,13 +507,20 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
   // context switch per request, and on a busy machine a wait for the woken thread to be scheduled;
   // the `planning` status that would precede a quick answer by a millisecond costs a DDS write.
   // Not in replica mode: there a vehicle's `planning` status is what the other replicas see first.
-  const bool plan_here = config_.service.inline_planning_ms > 0.0 && !shadows_;
+  // Only while the dispatcher keeps up: a request that waited in the reader is behind others,
+  // and on a machine short of CPU three threads get more of it than one (the scheduler is fair
+  // per thread), so the planning threads take the work then.
+  const bool plan_here = config_.service.inline_planning_ms > 0.0 && !shadows_ && waited_ms < kInlineMaxWaitMs;
   std::optional<PlanningJob> job = registry_.on_request(std::move(request), {}, plan_here);
   if (!job) return;  // rejected, or only the objects of the followed path updated
   if (plan_here) {
-    if (plan_inline(*job)) return;
+    if (plan_inline(*job)) {
+      if (metrics_) metrics_->on_search_inline();
+      return;
+    }
     registry_.release_planning(*job);
   }
+  if (metrics_) metrics_->on_search_handed_off(plan_here);
   const std::string vehicle = job->request.vehicle_id;
   if (queue_->push(std::move(*job))) {
     spdlog::debug("vehicle '{}': a waiting request was replaced by a newer one", vehicle);
@@ -518,18 +547,25 @@ bool PulloutService::plan_inline(PlanningJob& job) {
   const double budget_ms = effective_deadline_ms(job.request.deadline_ms);
   const double inline_ms = config_.service.inline_planning_ms;
   const bool whole_budget = budget_ms <= inline_ms;
-  const StopCondition stop =
-      StopCondition::after_ms(whole_budget ? budget_ms : inline_ms).with_cancel(job.cancel.get());
+  StopCondition stop = StopCondition::after_ms(whole_budget ? budget_ms : inline_ms).with_cancel(job.cancel.get());
   PlanningResult result;
-  try {
-    result = planner_.plan(job.request, stop, job.previous_world.get());
-  } catch (const std::exception&) {
-    return false;  // the planning thread runs it again and reports the failure
+  for (int attempt = 0;; ++attempt) {
+    const double cpu_before_ms = thread_cpu_ms();
+    try {
+      result = planner_.plan(job.request, stop, job.previous_world.get());
+    } catch (const std::exception&) {
+      return false;  // the planning thread runs it again and reports the failure
+    }
+    if (stopping_) return true;  // a search cut short by shutdown is not a "no path"
+    if (whole_budget || result.stopped == StopReason::kNone) break;
+    // Cut short by the inline budget (not the request's). When this thread ran for less than
+    // half of it, the clock ran out while it waited for a CPU (a busy machine), not because the
+    // search is long: once more, rather than a hand-off that would plan it all again and add a
+    // `planning` write and a wake-up. Else the planning thread searches again with the whole
+    // budget, from the start (a stopped search keeps nothing).
+    if (attempt > 0 || thread_cpu_ms() - cpu_before_ms >= 0.5 * inline_ms) return false;
+    stop = StopCondition::after_ms(inline_ms).with_cancel(job.cancel.get());
   }
-  if (stopping_) return true;  // a search cut short by shutdown is not a "no path"
-  // Cut short by the inline budget (not the request's): the planning thread searches again with
-  // the whole budget, from the start (a stopped search keeps nothing).
-  if (!whole_budget && result.stopped != StopReason::kNone) return false;
   finish(job, result, 0.0);
   return true;
 }

@@ -93,7 +93,8 @@ class PulloutService {
   // when it is reported gone), so max_instances bounds the map.
   using InstanceNames = std::map<eprosima::fastrtps::rtps::InstanceHandle_t, std::string>;
   void instance_gone(InstanceNames& names, const eprosima::fastdds::dds::SampleInfo& info, VehicleInput input);
-  void handle_request(const msg::PullOutRequest& sample);
+  // `waited_ms`: how long the sample waited in the reader (planned on the dispatcher only when short).
+  void handle_request(const msg::PullOutRequest& sample, double waited_ms);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
   // Dispatcher: plans the job itself within service.inline_planning_ms and publishes the result.
