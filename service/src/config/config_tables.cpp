@@ -440,9 +440,10 @@ const Table<ServiceConfig>& service_table() {
       field("worker_threads", &T::worker_threads, "", in(1, 64), "planning threads"),
       field("default_deadline_ms", &T::default_deadline_ms, "ms", above(0.0),
             "planning budget when a request gives none, <= limits.max_deadline_ms"),
-      field("inline_planning_ms", &T::inline_planning_ms, "ms", in(0.0, 50.0),
-            "the dispatcher plans a request itself up to this long while it keeps up (answer without a "
-            "`planning` status); longer searches go to a planning thread; 0 = always a planning thread"),
+      field("quick_answer_ms", &T::quick_answer_ms, "ms", in(0.0, 50.0),
+            "a search that ends within this is answered without a `planning` status first; 0 = `planning` at once"),
+      field("quick_answer_on_dispatcher", &T::quick_answer_on_dispatcher, "", AnyValue{},
+            "the quick attempt on the dispatcher thread itself (no hand-off) while it keeps up"),
       field("log_level", &T::log_level, "", Choices{{kLogLevels.begin(), kLogLevels.end()}}, ""),
       field("progress_timeout_s", &T::progress_timeout_s, "s", in(0.0, 60.0),
             "a departed vehicle silent this long is told to stop (odometry lost); 0 = never"),

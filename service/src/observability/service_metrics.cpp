@@ -63,12 +63,12 @@ ServiceMetrics::ServiceMetrics(const std::string& version) : registry_(std::make
   auto& searches = prometheus::BuildCounter()
                        .Name("pullout_searches_total")
                        .Help(
-                           "Searches by where they ran: the dispatcher (within service.inline_planning_ms), or a "
-                           "planning thread (at once, or after the dispatcher's attempt ran out of time)")
+                           "Searches by where they ran: answered within service.quick_answer_ms on the dispatcher or a "
+                           "planning thread (no planning status), or with the whole budget after the planning status")
                        .Register(*registry_);
-  searched_inline_ = &searches.Add({{"where", "dispatcher"}});
-  handed_off_ = &searches.Add({{"where", "planning_thread"}});
-  handed_off_after_inline_ = &searches.Add({{"where", "planning_thread_after_dispatcher"}});
+  searches_[static_cast<int>(SearchPlace::kDispatcherQuick)] = &searches.Add({{"where", "dispatcher_quick"}});
+  searches_[static_cast<int>(SearchPlace::kPlanningThreadQuick)] = &searches.Add({{"where", "planning_thread_quick"}});
+  searches_[static_cast<int>(SearchPlace::kPlanningThread)] = &searches.Add({{"where", "planning_thread"}});
   auto& replies = prometheus::BuildCounter()
                       .Name("pullout_replies_total")
                       .Help("Answers published, one per request, by outcome")
@@ -113,10 +113,7 @@ ServiceMetrics::ServiceMetrics(const std::string& version) : registry_(std::make
 ServiceMetrics::~ServiceMetrics() = default;
 
 void ServiceMetrics::on_request() { requests_->Increment(); }
-void ServiceMetrics::on_search_inline() { searched_inline_->Increment(); }
-void ServiceMetrics::on_search_handed_off(bool after_inline_attempt) {
-  (after_inline_attempt ? handed_off_after_inline_ : handed_off_)->Increment();
-}
+void ServiceMetrics::on_search(SearchPlace place) { searches_[static_cast<int>(place)]->Increment(); }
 
 prometheus::Counter& ServiceMetrics::field_counter(const std::string& field_class) {
   // Caller holds mutex_.

@@ -48,8 +48,9 @@ const char* outcome_name(PlanningResult::Outcome o) {
 }
 
 // [ms] A request that waited longer than this in the reader is handed to a planning thread, not
-// planned on the dispatcher: the dispatcher is behind (a burst, or a machine short of CPU).
-constexpr double kInlineMaxWaitMs = 5.0;
+// tried on the dispatcher (quick_answer_on_dispatcher): the dispatcher is behind (a burst, or a
+// machine short of CPU).
+constexpr double kDispatcherMaxWaitMs = 5.0;
 
 // [ms] How long ago Fast DDS received the sample (both stamps on this host's system clock); 0 when
 // the stamp is missing or in the future.
@@ -60,6 +61,10 @@ double waited_in_reader_ms(const dds::SampleInfo& info) {
       std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
   return received_ms > 0.0 && now_ms > received_ms ? now_ms - received_ms : 0.0;
 }
+
+// A job whose `planning` status is held back and that waited longer than this many quick budgets
+// (service.quick_answer_ms) for a planning thread gets the status at once (a long queue).
+constexpr double kHeldPlanningMaxWaitFactor = 10.0;
 
 // [ms] CPU time of the calling thread.
 double thread_cpu_ms() {
@@ -503,24 +508,27 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample, double wa
     spdlog::info("vehicle '{}' request {}: received (route of {} lanelets, {} objects)", request.vehicle_id,
                  request.request_id, request.route_lanelet_ids.size(), request.objects.size());
   }
-  // Planned here first when it is quick: a hand-off to a planning thread costs a wake-up and a
-  // context switch per request, and on a busy machine a wait for the woken thread to be scheduled;
-  // the `planning` status that would precede a quick answer by a millisecond costs a DDS write.
-  // Not in replica mode: there a vehicle's `planning` status is what the other replicas see first.
-  // Only while the dispatcher keeps up: a request that waited in the reader is behind others,
-  // and on a machine short of CPU three threads get more of it than one (the scheduler is fair
-  // per thread), so the planning threads take the work then.
-  const bool plan_here = config_.service.inline_planning_ms > 0.0 && !shadows_ && waited_ms < kInlineMaxWaitMs;
-  std::optional<PlanningJob> job = registry_.on_request(std::move(request), {}, plan_here);
+  // A search that ends within service.quick_answer_ms is answered without a `planning` status
+  // first: that status would precede the answer by about a millisecond and costs a DDS write at
+  // the service and a sample at the vehicle. The status is held back and written once the quick
+  // attempt runs out (quick_attempt). Not in replica mode: there a vehicle's `planning` status
+  // is what the other replicas see first.
+  const bool quick = config_.service.quick_answer_ms > 0.0 && !shadows_;
+  // The attempt on the dispatcher (quick_answer_on_dispatcher) saves the hand-off too, but only
+  // while the dispatcher keeps up: a request that waited in the reader is behind others, and on a
+  // machine short of CPU three threads get more of it than one (the scheduler is fair per thread).
+  const bool here = quick && config_.service.quick_answer_on_dispatcher && waited_ms < kDispatcherMaxWaitMs;
+  std::optional<PlanningJob> job = registry_.on_request(std::move(request), {}, quick);
   if (!job) return;  // rejected, or only the objects of the followed path updated
-  if (plan_here) {
-    if (plan_inline(*job)) {
-      if (metrics_) metrics_->on_search_inline();
+  if (here) {
+    if (quick_attempt(*job)) {
+      if (metrics_) metrics_->on_search(SearchPlace::kDispatcherQuick);
       return;
     }
     registry_.release_planning(*job);
+  } else if (quick) {
+    job->planning_held = true;
   }
-  if (metrics_) metrics_->on_search_handed_off(plan_here);
   const std::string vehicle = job->request.vehicle_id;
   if (queue_->push(std::move(*job))) {
     spdlog::debug("vehicle '{}': a waiting request was replaced by a newer one", vehicle);
@@ -543,28 +551,27 @@ void PulloutService::handle_progress(const msg::ExecutionProgress& sample) {
   registry_.on_progress(progress);
 }
 
-bool PulloutService::plan_inline(PlanningJob& job) {
+bool PulloutService::quick_attempt(PlanningJob& job) {
   const double budget_ms = effective_deadline_ms(job.request.deadline_ms);
-  const double inline_ms = config_.service.inline_planning_ms;
-  const bool whole_budget = budget_ms <= inline_ms;
-  StopCondition stop = StopCondition::after_ms(whole_budget ? budget_ms : inline_ms).with_cancel(job.cancel.get());
+  const double quick_ms = config_.service.quick_answer_ms;
+  const bool whole_budget = budget_ms <= quick_ms;
+  StopCondition stop = StopCondition::after_ms(whole_budget ? budget_ms : quick_ms).with_cancel(job.cancel.get());
   PlanningResult result;
   for (int attempt = 0;; ++attempt) {
     const double cpu_before_ms = thread_cpu_ms();
     try {
       result = planner_.plan(job.request, stop, job.previous_world.get());
     } catch (const std::exception&) {
-      return false;  // the planning thread runs it again and reports the failure
+      return false;  // searched again with the whole budget, which reports the failure
     }
-    if (stopping_) return true;  // a search cut short by shutdown is not a "no path"
+    if (stopping_ || job.cancel->load()) return true;  // shutdown or superseded: nothing to publish
     if (whole_budget || result.stopped == StopReason::kNone) break;
-    // Cut short by the inline budget (not the request's). When this thread ran for less than
+    // Cut short by the quick budget (not the request's). When this thread ran for less than
     // half of it, the clock ran out while it waited for a CPU (a busy machine), not because the
-    // search is long: once more, rather than a hand-off that would plan it all again and add a
-    // `planning` write and a wake-up. Else the planning thread searches again with the whole
-    // budget, from the start (a stopped search keeps nothing).
-    if (attempt > 0 || thread_cpu_ms() - cpu_before_ms >= 0.5 * inline_ms) return false;
-    stop = StopCondition::after_ms(inline_ms).with_cancel(job.cancel.get());
+    // search is long: once more, rather than the `planning` write and a whole search again. Else
+    // the search runs again with the whole budget, from the start (a stopped search keeps nothing).
+    if (attempt > 0 || thread_cpu_ms() - cpu_before_ms >= 0.5 * quick_ms) return false;
+    stop = StopCondition::after_ms(quick_ms).with_cancel(job.cancel.get());
   }
   finish(job, result, 0.0);
   return true;
@@ -578,6 +585,18 @@ void PulloutService::run_job(PlanningJob& job) {
   const double waited_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - job.accepted_at).count();
 
+  if (job.planning_held) {
+    // Its `planning` status was held back for a quick answer. A job that waited for a planning
+    // thread longer than kHeldPlanningMaxWaitFactor times that budget writes it at once: the
+    // vehicle hears that its request is in work within about that time.
+    if (waited_ms < kHeldPlanningMaxWaitFactor * config_.service.quick_answer_ms && quick_attempt(job)) {
+      if (metrics_) metrics_->on_search(SearchPlace::kPlanningThreadQuick);
+      return;
+    }
+    if (stopping_ || job.cancel->load()) return;
+    registry_.release_planning(job);
+  }
+  if (metrics_) metrics_->on_search(SearchPlace::kPlanningThread);
   PlanningResult result;
   try {
     result = planner_.plan(request, stop, job.previous_world.get());

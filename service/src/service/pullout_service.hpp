@@ -1,9 +1,10 @@
 // The pullout service: DDS in and out, a dispatcher thread and a pool of planning threads.
 //
 //   DDS readers --(WaitSet: DATA_AVAILABLE / shutdown guard)--> dispatcher thread
-//     request  -> convert + check -> kRejected, or planned on the dispatcher when quick
-//                 (service.inline_planning_ms: path + status, no kPlanning), else
-//                 kPlanning + per-vehicle job -> planning workers
+//     request  -> convert + check -> kRejected, or a per-vehicle job -> planning workers, its
+//                 kPlanning status held back: a search that ends within service.quick_answer_ms
+//                 is answered with path + status only, a longer one writes kPlanning first
+//                 (quick_answer_on_dispatcher: the quick attempt on the dispatcher itself)
 //     progress -> convert + check -> the vehicle's execution tracker -> status on change
 //   planning worker -> StartPlanner::plan(request, deadline) -> path + status
 //
@@ -97,9 +98,10 @@ class PulloutService {
   void handle_request(const msg::PullOutRequest& sample, double waited_ms);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
-  // Dispatcher: plans the job itself within service.inline_planning_ms and publishes the result.
-  // False when the search needs longer (or threw): the job is for a planning thread then.
-  bool plan_inline(PlanningJob& job);
+  // Searches the job within service.quick_answer_ms (on the calling thread) and publishes the
+  // result. False when the search needs longer (or threw): it must be searched again with the
+  // whole budget, after its held `planning` status is written.
+  bool quick_attempt(PlanningJob& job);
   // A search's result to the registry (published unless a newer request came), and the log.
   void finish(const PlanningJob& job, const PlanningResult& result, double waited_ms);
   // service.state_dir: every vehicle of the journal restored (before the dispatcher starts).
