@@ -622,8 +622,11 @@ int run_coordinator(const Options& o) {
   }
   std::vector<double> latencies;
   std::vector<std::vector<double>> by_second;  // latencies by the second of the send window (lost: inf)
-  std::vector<double> to_service_ms;           // send() -> the final status published
-  std::vector<double> from_service_ms;         // published -> arrived
+  // The two parts of the answered ones by second: at the service or in delivery.
+  std::vector<std::vector<double>> to_service_by_second;
+  std::vector<std::vector<double>> from_service_by_second;
+  std::vector<double> to_service_ms;    // send() -> the final status published
+  std::vector<double> from_service_ms;  // published -> arrived
   std::size_t sent = 0;
   std::size_t lost = 0;
   std::size_t not_planned = 0;
@@ -657,6 +660,12 @@ int run_coordinator(const Options& o) {
         if (to_service >= 0.0 || from_service >= 0.0) {
           to_service_ms.push_back(to_service);
           from_service_ms.push_back(from_service);
+          if (to_service_by_second.size() <= second) {
+            to_service_by_second.resize(second + 1);
+            from_service_by_second.resize(second + 1);
+          }
+          to_service_by_second[second].push_back(to_service);
+          from_service_by_second[second].push_back(from_service);
         }
         ++sent;
         if (latency < 0) {
@@ -713,6 +722,15 @@ int run_coordinator(const Options& o) {
   // Where in the window the slow replies are (warm-up, a stall, or throughout).
   std::printf("p99 [ms] by second of the send window:");
   for (const std::vector<double>& second : by_second) std::printf(" %.0f", pullout::bench::summarize(second).p99);
+  std::printf("\n");
+  std::printf("  of which send -> published:");
+  for (const std::vector<double>& second : to_service_by_second) {
+    std::printf(" %.0f", pullout::bench::summarize(second).p99);
+  }
+  std::printf("\n  and published -> arrived:  ");
+  for (const std::vector<double>& second : from_service_by_second) {
+    std::printf(" %.0f", pullout::bench::summarize(second).p99);
+  }
   std::printf("\n");
   if (metrics) {
     std::printf("replies published by the services after the drain: %.0f (requests answered: %zu)\n", replies_sum,

@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -543,6 +544,44 @@ TEST_F(ServiceDds, NoPathGivesAStopPathWithReasons) {
   for (const auto& segment : path->partial_paths) {
     for (const auto& p : segment.points) EXPECT_EQ(p.longitudinal_velocity_mps, 0.0);
   }
+}
+
+// The request's statuses in the order they arrived.
+std::vector<ExecutionState> states_of(const std::vector<PullOutStatus>& statuses, const std::string& vehicle,
+                                      std::uint64_t request_id) {
+  std::vector<ExecutionState> states;
+  for (const auto& s : statuses) {
+    if (s.vehicle_id == vehicle && s.request_id == request_id) states.push_back(s.state);
+  }
+  return states;
+}
+
+TEST_F(ServiceDds, ASearchLongerThanTheQuickBudgetIsAnnouncedAsPlanningFirst) {
+  // Every lane-based attempt fails (132 of them) and the freespace planner tries too: the search
+  // takes far longer than service.quick_answer_ms (2 ms), so `planning` is written when the quick
+  // attempt runs out, before the answer and never after it.
+  ASSERT_TRUE(client_->send(scenario_request("full_search", "long-1", 81)));
+  const auto status = client_->final_status("long-1", 81);
+  ASSERT_TRUE(status.has_value());
+  const std::vector<ExecutionState> states = states_of(client_->statuses->samples(), "long-1", 81);
+  ASSERT_GE(states.size(), 2u) << "answered " << to_string(status->state) << " in " << status->planning_time_ms
+                               << " ms with no `planning` status";
+  EXPECT_EQ(states.front(), ExecutionState::kPlanning);
+  EXPECT_NE(states.back(), ExecutionState::kPlanning);
+  EXPECT_EQ(std::count(states.begin(), states.end(), ExecutionState::kPlanning), 1);
+}
+
+TEST_F(ServiceDds, NoPlanningStatusFollowsTheAnswer) {
+  // A quick search is answered without `planning` (or, on a slow machine, with it first): either
+  // way the answer is the request's last status.
+  ASSERT_TRUE(client_->send(scenario_request("straight_shoulder", "quick-1", 82)));
+  const auto status = client_->final_status("quick-1", 82);
+  ASSERT_TRUE(status.has_value());
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // a late `planning` would be here by now
+  const std::vector<ExecutionState> states = states_of(client_->statuses->samples(), "quick-1", 82);
+  ASSERT_FALSE(states.empty());
+  EXPECT_EQ(states.back(), ExecutionState::kWaitingApproval);
+  EXPECT_LE(std::count(states.begin(), states.end(), ExecutionState::kPlanning), 1);
 }
 
 TEST_F(ServiceDds, MalformedRequestIsRejectedNamingTheField) {

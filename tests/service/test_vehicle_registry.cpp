@@ -288,5 +288,77 @@ TEST_F(RegistryObservers, RejectionsAndEvictionsAreReported) {
   EXPECT_EQ(evictions_[1], EvictionReason::kIdle);
 }
 
+// A `planning` status kept back (the dispatcher tries the search itself first): never written
+// after the result or after a newer request's samples, written first when released before them.
+class HeldPlanning : public Registry {
+ protected:
+  PlanningJob hold(const std::string& vehicle, std::uint64_t id) {
+    std::optional<PlanningJob> job = registry_->on_request(request(vehicle, id), {}, /*hold_planning=*/true);
+    EXPECT_TRUE(job.has_value()) << vehicle;
+    return job ? std::move(*job) : PlanningJob{};
+  }
+  std::vector<ExecutionState> states_of(const std::string& vehicle) const {
+    std::vector<ExecutionState> states;
+    for (const PullOutStatus& s : outbox_.statuses) {
+      if (s.vehicle_id == vehicle) states.push_back(s.state);
+    }
+    return states;
+  }
+};
+
+TEST_F(HeldPlanning, WithoutHoldingThePlanningStatusIsWrittenAtOnce) {
+  start("a", 1);
+  EXPECT_EQ(states_of("a"), std::vector<ExecutionState>{ExecutionState::kPlanning});
+}
+
+TEST_F(HeldPlanning, AQuickResultIsTheFirstSampleAndALateReleaseWritesNothing) {
+  const PlanningJob job = hold("a", 1);
+  EXPECT_TRUE(outbox_.statuses.empty());
+  EXPECT_TRUE(outbox_.paths.empty());
+  registry_->on_result(job, planner_.plan(job.request, StopCondition()));
+  ASSERT_EQ(outbox_.paths.size(), 1u);
+  EXPECT_EQ(states_of("a"), std::vector<ExecutionState>{ExecutionState::kWaitingApproval});
+  registry_->release_planning(job);  // too late: the answer is out
+  EXPECT_EQ(states_of("a"), std::vector<ExecutionState>{ExecutionState::kWaitingApproval});
+}
+
+TEST_F(HeldPlanning, AReleasedPlanningStatusPrecedesTheResult) {
+  const PlanningJob job = hold("a", 1);
+  registry_->release_planning(job);
+  EXPECT_EQ(states_of("a"), std::vector<ExecutionState>{ExecutionState::kPlanning});
+  registry_->release_planning(job);  // once only
+  registry_->on_result(job, planner_.plan(job.request, StopCondition()));
+  EXPECT_EQ(states_of("a"), (std::vector<ExecutionState>{ExecutionState::kPlanning, ExecutionState::kWaitingApproval}));
+  EXPECT_EQ(outbox_.statuses.back().request_id, 1u);
+}
+
+TEST_F(HeldPlanning, ANewerRequestsSampleDropsTheOlderHeldStatus) {
+  const PlanningJob first = hold("a", 1);
+  registry_->release_planning(first);  // the vehicle hears of request 1
+  const PlanningJob second = hold("a", 2);
+  const PlanningJob third = hold("a", 3);
+  registry_->release_planning(second);  // request 3 came since: nothing for request 2
+  ASSERT_EQ(outbox_.statuses.size(), 1u);
+  registry_->release_planning(third);
+  ASSERT_EQ(outbox_.statuses.size(), 2u);
+  EXPECT_EQ(outbox_.statuses.back().request_id, 3u);
+  EXPECT_EQ(outbox_.statuses.back().state, ExecutionState::kPlanning);
+  // The second search's result is void; the third's is published.
+  registry_->on_result(second, planner_.plan(second.request, StopCondition()));
+  EXPECT_EQ(outbox_.statuses.size(), 2u);
+  registry_->on_result(third, planner_.plan(third.request, StopCondition()));
+  EXPECT_EQ(outbox_.statuses.back().request_id, 3u);
+  EXPECT_EQ(outbox_.statuses.back().state, ExecutionState::kWaitingApproval);
+}
+
+TEST_F(HeldPlanning, ARepeatedRequestWritesTheCurrentPlanningStatusAndTheHeldOneIsNotWrittenAgain) {
+  const PlanningJob job = hold("a", 1);
+  PullOutRequest again = job.request;
+  EXPECT_FALSE(registry_->on_request(again, {}, /*hold_planning=*/true).has_value());  // no second search
+  EXPECT_EQ(states_of("a"), std::vector<ExecutionState>{ExecutionState::kPlanning});
+  registry_->release_planning(job);
+  EXPECT_EQ(states_of("a"), std::vector<ExecutionState>{ExecutionState::kPlanning});
+}
+
 }  // namespace
 }  // namespace pullout::service

@@ -60,6 +60,15 @@ ServiceMetrics::ServiceMetrics(const std::string& version) : registry_(std::make
                    .Help("PullOutRequest samples taken from DDS")
                    .Register(*registry_)
                    .Add({});
+  auto& searches = prometheus::BuildCounter()
+                       .Name("pullout_searches_total")
+                       .Help(
+                           "Searches by where they ran: answered within service.quick_answer_ms on the dispatcher or a "
+                           "planning thread (no planning status), or with the whole budget after the planning status")
+                       .Register(*registry_);
+  searches_[static_cast<int>(SearchPlace::kDispatcherQuick)] = &searches.Add({{"where", "dispatcher_quick"}});
+  searches_[static_cast<int>(SearchPlace::kPlanningThreadQuick)] = &searches.Add({{"where", "planning_thread_quick"}});
+  searches_[static_cast<int>(SearchPlace::kPlanningThread)] = &searches.Add({{"where", "planning_thread"}});
   auto& replies = prometheus::BuildCounter()
                       .Name("pullout_replies_total")
                       .Help("Answers published, one per request, by outcome")
@@ -104,6 +113,7 @@ ServiceMetrics::ServiceMetrics(const std::string& version) : registry_(std::make
 ServiceMetrics::~ServiceMetrics() = default;
 
 void ServiceMetrics::on_request() { requests_->Increment(); }
+void ServiceMetrics::on_search(SearchPlace place) { searches_[static_cast<int>(place)]->Increment(); }
 
 prometheus::Counter& ServiceMetrics::field_counter(const std::string& field_class) {
   // Caller holds mutex_.

@@ -18,6 +18,7 @@
 //                                                      seen on the domain right now
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <memory>
 #include <mutex>
@@ -43,6 +44,10 @@ enum class EvictionReason;
 // Empty when the line names no field.
 std::string rejection_field_class(const std::string& line);
 
+// Where a search ran: answered within service.quick_answer_ms on the dispatcher or on a planning
+// thread (no `planning` status), or on a planning thread with the whole budget after `planning`.
+enum class SearchPlace { kDispatcherQuick = 0, kPlanningThreadQuick = 1, kPlanningThread = 2 };
+
 class ServiceMetrics {
  public:
   // `version`: the build_info label.
@@ -60,6 +65,8 @@ class ServiceMetrics {
   void set_vehicles(std::size_t n);
   void set_queue_depth(std::size_t n);
   void set_other_services(std::size_t n);
+  // Where a search ran, and whether it was answered within service.quick_answer_ms.
+  void on_search(SearchPlace place);
 
   // Distinct rejection field classes kept as labels; the rest count as "other" (a label per
   // distinct value is a time series for ever).
@@ -70,6 +77,7 @@ class ServiceMetrics {
 
   std::shared_ptr<prometheus::Registry> registry_;
   prometheus::Counter* requests_{nullptr};
+  std::array<prometheus::Counter*, 3> searches_{};  // by SearchPlace
   prometheus::Counter* found_{nullptr};
   prometheus::Counter* no_path_{nullptr};
   prometheus::Counter* rejected_{nullptr};

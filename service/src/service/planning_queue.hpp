@@ -36,6 +36,9 @@ struct PlanningJob {
   // The vehicle's previous world (SearchOrder::previous_world): StartPlanner::plan reuses its lane
   // world when the lanes are identical.
   std::shared_ptr<const PlannedWorld> previous_world;
+  // Its `planning` status is held back (VehicleRegistry::on_request hold_planning): the planning
+  // thread tries a quick answer first and writes the status (release_planning) when it runs out.
+  bool planning_held{false};
 };
 
 class PlanningQueue {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <exception>
 #include <iterator>
 #include <mutex>
@@ -44,6 +45,32 @@ const char* outcome_name(PlanningResult::Outcome o) {
       return "rejected";
   }
   return "?";
+}
+
+// [ms] A request that waited longer than this in the reader is handed to a planning thread, not
+// tried on the dispatcher (quick_answer_on_dispatcher): the dispatcher is behind (a burst, or a
+// machine short of CPU).
+constexpr double kDispatcherMaxWaitMs = 5.0;
+
+// [ms] How long ago Fast DDS received the sample (both stamps on this host's system clock); 0 when
+// the stamp is missing or in the future.
+double waited_in_reader_ms(const dds::SampleInfo& info) {
+  const eprosima::fastrtps::rtps::Time_t& r = info.reception_timestamp;
+  const double received_ms = static_cast<double>(r.seconds()) * 1e3 + static_cast<double>(r.nanosec()) / 1e6;
+  const double now_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return received_ms > 0.0 && now_ms > received_ms ? now_ms - received_ms : 0.0;
+}
+
+// A job whose `planning` status is held back and that waited longer than this many quick budgets
+// (service.quick_answer_ms) for a planning thread gets the status at once (a long queue).
+constexpr double kHeldPlanningMaxWaitFactor = 10.0;
+
+// [ms] CPU time of the calling thread.
+double thread_cpu_ms() {
+  timespec t{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) / 1e6;
 }
 
 RegistryOptions registry_options(const ServiceConfig& service, ServiceMetrics* metrics) {
@@ -255,7 +282,7 @@ void PulloutService::take_requests() {
           }
           continue;
         }
-        handle_request(sample);
+        handle_request(sample, waited_in_reader_ms(info));
       } else {
         instance_gone(request_instances_, info, VehicleInput::kRequest);
       }
@@ -457,7 +484,7 @@ void PulloutService::instance_gone(InstanceNames& names, const dds::SampleInfo& 
   names.erase(it);
 }
 
-void PulloutService::handle_request(const msg::PullOutRequest& sample) {
+void PulloutService::handle_request(const msg::PullOutRequest& sample, double waited_ms) {
   if (metrics_) metrics_->on_request();
   if (sample.vehicle_id().size() > kMaxVehicleIdBytes) {
     spdlog::warn("request {} dropped: vehicle_id of {} bytes cannot be answered (at most {})", sample.request_id(),
@@ -481,8 +508,27 @@ void PulloutService::handle_request(const msg::PullOutRequest& sample) {
     spdlog::info("vehicle '{}' request {}: received (route of {} lanelets, {} objects)", request.vehicle_id,
                  request.request_id, request.route_lanelet_ids.size(), request.objects.size());
   }
-  std::optional<PlanningJob> job = registry_.on_request(std::move(request), {});
+  // A search that ends within service.quick_answer_ms is answered without a `planning` status
+  // first: that status would precede the answer by about a millisecond and costs a DDS write at
+  // the service and a sample at the vehicle. The status is held back and written once the quick
+  // attempt runs out (quick_attempt). Not in replica mode: there a vehicle's `planning` status
+  // is what the other replicas see first.
+  const bool quick = config_.service.quick_answer_ms > 0.0 && !shadows_;
+  // The attempt on the dispatcher (quick_answer_on_dispatcher) saves the hand-off too, but only
+  // while the dispatcher keeps up: a request that waited in the reader is behind others, and on a
+  // machine short of CPU three threads get more of it than one (the scheduler is fair per thread).
+  const bool here = quick && config_.service.quick_answer_on_dispatcher && waited_ms < kDispatcherMaxWaitMs;
+  std::optional<PlanningJob> job = registry_.on_request(std::move(request), {}, quick);
   if (!job) return;  // rejected, or only the objects of the followed path updated
+  if (here) {
+    if (quick_attempt(*job)) {
+      if (metrics_) metrics_->on_search(SearchPlace::kDispatcherQuick);
+      return;
+    }
+    registry_.release_planning(*job);
+  } else if (quick) {
+    job->planning_held = true;
+  }
   const std::string vehicle = job->request.vehicle_id;
   if (queue_->push(std::move(*job))) {
     spdlog::debug("vehicle '{}': a waiting request was replaced by a newer one", vehicle);
@@ -505,6 +551,32 @@ void PulloutService::handle_progress(const msg::ExecutionProgress& sample) {
   registry_.on_progress(progress);
 }
 
+bool PulloutService::quick_attempt(PlanningJob& job) {
+  const double budget_ms = effective_deadline_ms(job.request.deadline_ms);
+  const double quick_ms = config_.service.quick_answer_ms;
+  const bool whole_budget = budget_ms <= quick_ms;
+  StopCondition stop = StopCondition::after_ms(whole_budget ? budget_ms : quick_ms).with_cancel(job.cancel.get());
+  PlanningResult result;
+  for (int attempt = 0;; ++attempt) {
+    const double cpu_before_ms = thread_cpu_ms();
+    try {
+      result = planner_.plan(job.request, stop, job.previous_world.get());
+    } catch (const std::exception&) {
+      return false;  // searched again with the whole budget, which reports the failure
+    }
+    if (stopping_ || job.cancel->load()) return true;  // shutdown or superseded: nothing to publish
+    if (whole_budget || result.stopped == StopReason::kNone) break;
+    // Cut short by the quick budget (not the request's). When this thread ran for less than
+    // half of it, the clock ran out while it waited for a CPU (a busy machine), not because the
+    // search is long: once more, rather than the `planning` write and a whole search again. Else
+    // the search runs again with the whole budget, from the start (a stopped search keeps nothing).
+    if (attempt > 0 || thread_cpu_ms() - cpu_before_ms >= 0.5 * quick_ms) return false;
+    stop = StopCondition::after_ms(quick_ms).with_cancel(job.cancel.get());
+  }
+  finish(job, result, 0.0);
+  return true;
+}
+
 void PulloutService::run_job(PlanningJob& job) {
   const PullOutRequest& request = job.request;
   if (stopping_ || job.cancel->load()) return;  // superseded or shutting down before it started
@@ -513,6 +585,18 @@ void PulloutService::run_job(PlanningJob& job) {
   const double waited_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - job.accepted_at).count();
 
+  if (job.planning_held) {
+    // Its `planning` status was held back for a quick answer. A job that waited for a planning
+    // thread longer than kHeldPlanningMaxWaitFactor times that budget writes it at once: the
+    // vehicle hears that its request is in work within about that time.
+    if (waited_ms < kHeldPlanningMaxWaitFactor * config_.service.quick_answer_ms && quick_attempt(job)) {
+      if (metrics_) metrics_->on_search(SearchPlace::kPlanningThreadQuick);
+      return;
+    }
+    if (stopping_ || job.cancel->load()) return;
+    registry_.release_planning(job);
+  }
+  if (metrics_) metrics_->on_search(SearchPlace::kPlanningThread);
   PlanningResult result;
   try {
     result = planner_.plan(request, stop, job.previous_world.get());
@@ -522,6 +606,11 @@ void PulloutService::run_job(PlanningJob& job) {
     return;
   }
   if (stopping_) return;  // a search cut short by shutdown is not a "no path"
+  finish(job, result, waited_ms);
+}
+
+void PulloutService::finish(const PlanningJob& job, const PlanningResult& result, double waited_ms) {
+  const PullOutRequest& request = job.request;
   registry_.on_result(job, result);
   if (result.outcome == PlanningResult::Outcome::kFound) {
     spdlog::info("vehicle '{}' request {}: {} path, {} segment(s), {:.1f} ms (+{:.1f} ms queued)", request.vehicle_id,

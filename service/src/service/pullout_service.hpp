@@ -1,7 +1,10 @@
 // The pullout service: DDS in and out, a dispatcher thread and a pool of planning threads.
 //
 //   DDS readers --(WaitSet: DATA_AVAILABLE / shutdown guard)--> dispatcher thread
-//     request  -> convert + check -> kRejected, or kPlanning + per-vehicle job -> planning workers
+//     request  -> convert + check -> kRejected, or a per-vehicle job -> planning workers, its
+//                 kPlanning status held back: a search that ends within service.quick_answer_ms
+//                 is answered with path + status only, a longer one writes kPlanning first
+//                 (quick_answer_on_dispatcher: the quick attempt on the dispatcher itself)
 //     progress -> convert + check -> the vehicle's execution tracker -> status on change
 //   planning worker -> StartPlanner::plan(request, deadline) -> path + status
 //
@@ -91,9 +94,16 @@ class PulloutService {
   // when it is reported gone), so max_instances bounds the map.
   using InstanceNames = std::map<eprosima::fastrtps::rtps::InstanceHandle_t, std::string>;
   void instance_gone(InstanceNames& names, const eprosima::fastdds::dds::SampleInfo& info, VehicleInput input);
-  void handle_request(const msg::PullOutRequest& sample);
+  // `waited_ms`: how long the sample waited in the reader (planned on the dispatcher only when short).
+  void handle_request(const msg::PullOutRequest& sample, double waited_ms);
   void handle_progress(const msg::ExecutionProgress& sample);
   void run_job(PlanningJob& job);
+  // Searches the job within service.quick_answer_ms (on the calling thread) and publishes the
+  // result. False when the search needs longer (or threw): it must be searched again with the
+  // whole budget, after its held `planning` status is written.
+  bool quick_attempt(PlanningJob& job);
+  // A search's result to the registry (published unless a newer request came), and the log.
+  void finish(const PlanningJob& job, const PlanningResult& result, double waited_ms);
   // service.state_dir: every vehicle of the journal restored (before the dispatcher starts).
   void restore_from_journal();
   // A snapshot's session rebuilt in the registry, its search (if any) queued.

@@ -227,6 +227,8 @@ std::optional<PlanningJob> VehicleRegistry::settle(Slot& slot, std::unique_lock<
   }
   if (!effects.note.empty()) spdlog::debug("vehicle '{}': {}", vehicle_id, effects.note);
   if (!effects.path && !effects.status) return job;
+  // Whatever is written now is newer than a `planning` status kept back: it must never follow.
+  slot.held_planning.reset();
 
   // Hand over: the next input of this vehicle may be worked on while these samples are written,
   // but its samples wait for these.
@@ -262,7 +264,8 @@ std::optional<PlanningJob> VehicleRegistry::settle(Slot& slot, std::unique_lock<
 }
 
 std::optional<PlanningJob> VehicleRegistry::on_request(PullOutRequest request,
-                                                       const std::vector<RequestIssue>& conversion_issues) {
+                                                       const std::vector<RequestIssue>& conversion_issues,
+                                                       bool hold_planning) {
   const std::string vehicle_id = request.vehicle_id;
   const std::uint64_t request_id = request.request_id;
   const auto now = options_.clock();
@@ -282,9 +285,31 @@ std::optional<PlanningJob> VehicleRegistry::on_request(PullOutRequest request,
     spdlog::info("vehicle '{}' request {}: {}", vehicle_id, request_id, effects.note);
     effects.note.clear();
   }
+  std::optional<PullOutStatus> held;
+  if (hold_planning && effects.search && !effects.path && effects.status &&
+      effects.status->state == ExecutionState::kPlanning) {
+    held = std::move(effects.status);
+    effects.status.reset();
+  }
   std::optional<PlanningJob> job = settle(*slot, lock, std::move(effects), vehicle_id);
+  if (held && job) {
+    // Still under the slot's lock: settle wrote nothing, so it kept the lock.
+    slot->held_planning = std::move(held);
+    slot->held_sequence = job->sequence;
+  }
   if (job) add_fleet_objects(*job);
   return job;
+}
+
+void VehicleRegistry::release_planning(const PlanningJob& job) {
+  const auto slot = find(job.request.vehicle_id);
+  if (!slot) return;
+  std::unique_lock<std::mutex> lock(slot->mutex);
+  if (slot->evicted || !slot->held_planning || slot->held_sequence != job.sequence) return;
+  SessionEffects effects;
+  effects.status = std::move(slot->held_planning);
+  slot->held_planning.reset();
+  settle(*slot, lock, std::move(effects), job.request.vehicle_id);
 }
 
 void VehicleRegistry::on_result(const PlanningJob& job, const PlanningResult& result) {

@@ -96,8 +96,15 @@ class VehicleRegistry {
   VehicleRegistry(const StartPlanner& planner, Outbox& outbox, RegistryOptions options = {});
 
   // A request; `conversion_issues` are the problems found while decoding it. Returns the search
-  // to queue, if the session ordered one.
-  std::optional<PlanningJob> on_request(PullOutRequest request, const std::vector<RequestIssue>& conversion_issues);
+  // to queue, if the session ordered one. `hold_planning`: the `planning` status of a search
+  // order is kept back instead of written (the caller tries the search at once, so that a quick
+  // answer is the vehicle's first sample); release_planning writes it, and any later sample of
+  // the vehicle (the result above all) drops it.
+  std::optional<PlanningJob> on_request(PullOutRequest request, const std::vector<RequestIssue>& conversion_issues,
+                                        bool hold_planning = false);
+  // Writes the `planning` status on_request kept back for `job`, unless something newer of the
+  // vehicle was written since (then nothing).
+  void release_planning(const PlanningJob& job);
   // A finished search; publishes nothing when a newer request of the vehicle came meanwhile.
   void on_result(const PlanningJob& job, const PlanningResult& result);
   // The search threw (a bug in the core).
@@ -140,6 +147,10 @@ class VehicleRegistry {
     bool request_alive{false};
     bool progress_alive{false};
     bool evicted{false};  // removed from the map: publishes nothing more (guarded by mutex)
+    // The `planning` status of search `held_sequence`, kept back by on_request(hold_planning)
+    // (guarded by mutex; dropped when any later sample of the vehicle is written).
+    std::optional<PullOutStatus> held_planning;
+    std::uint64_t held_sequence{0};
     // The last request and outcome reported to on_reply (guarded by publish_mutex).
     std::uint64_t replied_request_id{0};
     int replied_outcome{-1};

@@ -64,6 +64,15 @@ struct ReplicaConfig {
 struct ServiceConfig {
   int worker_threads{2};
   double default_deadline_ms{200.0};  // [ms]
+  // [ms] A search that ends within this is answered without a `planning` status (the path and
+  // the final status are the request's first samples): the planning thread tries it with this
+  // budget first, and writes `planning` and searches again with the whole budget when it runs out.
+  // 0: `planning` written when the request is accepted.
+  double quick_answer_ms{2.0};
+  // The quick attempt on the dispatcher itself (no hand-off) while it keeps up. Off: on a machine
+  // short of CPU the one busy dispatcher thread got less of it than three lighter threads and
+  // fell up to 1 s behind (bench/RESULTS.md, "Planning on the dispatcher").
+  bool quick_answer_on_dispatcher{false};
   RequestLimits limits;
   std::string log_level{"info"};  // one of kLogLevels
   // [s] A departed vehicle with no progress sample for this long is told to stop (0: never).
