@@ -91,6 +91,14 @@ std::unique_ptr<ServiceMetrics> make_metrics(const Config& config) {
   return std::make_unique<ServiceMetrics>(kVersionString);
 }
 
+std::unique_ptr<HttpEndpoint> make_http(const Config& config, const ServiceMetrics* metrics, HealthState& health) {
+  if (metrics == nullptr) return nullptr;
+  const MetricsConfig& m = config.observability.metrics;
+  auto http = std::make_unique<HttpEndpoint>(m.address, m.port, metrics->registry(), health);
+  spdlog::info("metrics and health on http://{}:{} (/metrics, /healthz, /readyz)", m.address, http->port());
+  return http;
+}
+
 std::unique_ptr<StateJournal> make_journal(const Config& config, Outbox& next) {
   if (config.service.state_dir.empty()) return nullptr;
   return std::make_unique<StateJournal>(config.service.state_dir, next);
@@ -101,6 +109,7 @@ std::unique_ptr<StateJournal> make_journal(const Config& config, Outbox& next) {
 PulloutService::PulloutService(const Config& config, std::shared_ptr<const LaneletMap> map)
     : config_(config),
       metrics_(make_metrics(config)),
+      http_(make_http(config, metrics_.get(), health_)),
       dds_(config.dds, config.service.replica),
       journal_(make_journal(config, dds_)),
       planner_(config.vehicle, config.start_planner, config.service.limits, std::move(map), config.vehicle_profiles),
@@ -124,11 +133,6 @@ PulloutService::PulloutService(const Config& config, std::shared_ptr<const Lanel
   }
   queue_ = std::make_unique<PlanningQueue>(config_.service.worker_threads, [this](PlanningJob& job) { run_job(job); });
   health_.workers_running = true;
-  if (metrics_) {
-    const MetricsConfig& m = config_.observability.metrics;
-    http_ = std::make_unique<HttpEndpoint>(m.address, m.port, metrics_->registry(), health_);
-    spdlog::info("metrics and health on http://{}:{} (/metrics, /healthz, /readyz)", m.address, http_->port());
-  }
 }
 
 PulloutService::~PulloutService() { stop(); }

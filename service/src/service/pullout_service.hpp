@@ -113,6 +113,10 @@ class PulloutService {
   // First: the registry's and the queue's observers use them until those are gone.
   HealthState health_;
   std::unique_ptr<ServiceMetrics> metrics_;  // null when observability.metrics is off
+  // Listening before the DDS endpoints exist: a client that matched the service can reach it
+  // (/readyz says not ready until the dispatcher runs). Serves only health_ and metrics_; stop()
+  // stops it first.
+  std::unique_ptr<HttpEndpoint> http_;
   DdsEdge dds_;
   // service.state_dir: journals what the registry publishes, then hands it to dds_ (null: off).
   std::unique_ptr<StateJournal> journal_;
@@ -136,8 +140,6 @@ class PulloutService {
   InstanceNames replica_status_instances_;
   // Last: destroyed (workers joined) before the registry and the DDS entities they use.
   std::unique_ptr<PlanningQueue> queue_;
-  // After the queue: serves /readyz about everything above; stopped first.
-  std::unique_ptr<HttpEndpoint> http_;
 };
 
 }  // namespace pullout::service
