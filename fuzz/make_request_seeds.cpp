@@ -14,6 +14,11 @@
 // named by a profile and given dimensions at once, and two hand-made CDR streams (a sequence
 // length of 2^31 - 1 with nothing behind it, and a truncated encoding). The seeds are committed
 // (fuzz/corpus/request/); scripts/fuzz --seeds regenerates them.
+//
+//   make_request_seeds --progress <output dir> <scenario file>
+//
+// writes fuzz_progress's seeds instead (fuzz/corpus/progress/): pullout/progress samples of the
+// scenario's vehicle at its start (write_progress_seeds).
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -43,12 +48,17 @@ using pullout::Point2;
 using pullout::Pose2;
 using pullout::PullOutRequest;
 
-std::string encode(const pullout::msg::PullOutRequest& message) {
-  pullout::idl::GuardedType<pullout::msg::PullOutRequestPubSubType> type;
+template <typename PubSubType, typename Message>
+std::string encode_as(const Message& message) {
+  pullout::idl::GuardedType<PubSubType> type;
   auto copy = message;
   eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(&copy)());
   if (!type.serialize(&copy, &payload)) throw std::runtime_error("serialize failed");
   return std::string(reinterpret_cast<const char*>(payload.data), payload.length);
+}
+
+std::string encode(const pullout::msg::PullOutRequest& message) {
+  return encode_as<pullout::msg::PullOutRequestPubSubType>(message);
 }
 
 void write(const fs::path& file, const std::string& bytes) {
@@ -202,9 +212,54 @@ void write_bad_requests(const fs::path& dir) {
 
 }  // namespace
 
+// fuzz_progress's seeds: progress samples of the scenario's vehicle standing at its start (the
+// start of the path fuzz_progress plans there), for its request (request id 0), not approved,
+// approved, moving, for another request, and the speeds the validation refuses.
+void write_progress_seeds(const fs::path& dir, const pullout::Scenario& scenario) {
+  pullout::ExecutionProgress p;
+  p.vehicle_id = "fuzz";
+  p.request_id = 0;
+  p.stamp_ns = 5'000'000'000;
+  p.pose = scenario.request.ego_pose;
+  const auto put = [&dir](const std::string& name, const pullout::ExecutionProgress& progress) {
+    write(dir / name, encode_as<pullout::msg::ExecutionProgressPubSubType>(pullout::idl::to_msg(progress)));
+  };
+  put("standing.cdr", p);
+  pullout::ExecutionProgress approved = p;
+  approved.approved = true;
+  put("standing_approved.cdr", approved);
+  pullout::ExecutionProgress moving = approved;
+  moving.velocity_mps = 1.5;
+  moving.pose.x += 2.0;
+  put("moving_approved.cdr", moving);
+  pullout::ExecutionProgress other = p;
+  other.request_id = 99;
+  put("other_request.cdr", other);
+  pullout::ExecutionProgress fast = p;
+  fast.velocity_mps = std::numeric_limits<double>::infinity();
+  put("bad_velocity_infinite.cdr", fast);
+  fast.velocity_mps = 1e300;
+  put("bad_velocity_1e300.cdr", fast);
+  pullout::ExecutionProgress far = p;
+  far.pose.x = 1e20;
+  put("bad_pose_1e20.cdr", far);
+}
+
 int main(int argc, char** argv) {
+  if (argc == 4 && std::string(argv[1]) == "--progress") {
+    try {
+      const fs::path dir(argv[2]);
+      fs::create_directories(dir);
+      write_progress_seeds(dir, pullout::load_scenario(argv[3]));
+    } catch (const std::exception& e) {
+      std::cerr << "make_request_seeds: " << e.what() << "\n";
+      return 1;
+    }
+    return 0;
+  }
   if (argc < 2) {
-    std::cerr << "usage: make_request_seeds <output dir> <scenario files...>\n";
+    std::cerr << "usage: make_request_seeds <output dir> <scenario files...>\n"
+                 "       make_request_seeds --progress <output dir> <scenario file>\n";
     return 2;
   }
   try {
