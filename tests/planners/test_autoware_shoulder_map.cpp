@@ -33,9 +33,11 @@ namespace {
 
 using namespace oracle;  // NOLINT: the test's own helpers
 
-// Shoulders passing at every possible start yaw, as measured when this test was written.
+// Shoulders passing at every possible start yaw, as measured when this test was written
+// (geometric 37; 40 on main on 2026-12-03; 42 since the S may turn towards the road first where
+// the end lies on the kerb side of the start's heading: 10988 and 10992, see solve_arc_pair).
 constexpr std::size_t kShiftShoulderFloor = 40;
-constexpr std::size_t kGeometricShoulderFloor = 37;
+constexpr std::size_t kGeometricShoulderFloor = 42;
 
 // [m] Neighbouring lanelets of these maps are sometimes a few centimetres apart instead of
 // sharing a bound (675 and 676 on the road_shoulder map: 4.8 cm); the lane world joins lanes whose

@@ -172,7 +172,11 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
     std::optional<TwoTurnPath> turns;
     const double s_end = s_base + k;
     if (!tangent_round && q >= 0.0 && s_end <= center.length()) {
-      turns = solve_arc_pair(start, center.pose_at(s_end), r_first, r_min);
+      const Pose2 end = center.pose_at(s_end);
+      turns = solve_arc_pair(start, end, r_first, r_min);
+      // The end beside the kerb side of the start's heading (a start turned towards the road,
+      // the road bending back): the S still turns towards the road first, as Autoware's.
+      if (!turns) turns = solve_arc_pair(start, end, r_first, r_min, side);
     }
     const bool arc_pair = turns.has_value();
     if (!arc_pair) {
