@@ -19,7 +19,8 @@
 // edge beyond the end pose, and the rear corner on the kerb side over the first arc against the
 // kerb-side lane edge; a candidate that fails is rejected as lane departure. Unlike Autoware, when
 // the rear corner's swing at R_min would cross the kerb-side edge (a car parked close to the
-// kerb), R1 is raised to the smallest radius whose swing fits, rather than giving up. Where no S
+// kerb), R1 is raised to the smallest radius whose swing fits with 1 cm to spare, rather than
+// giving up. Where no S
 // reaches the end pose (a start across the road: out of a perpendicular bay), the candidate is
 // two turns at R_min joined by a common tangent of the offset's length (the same way or opposite
 // ways, solve_two_turn).
