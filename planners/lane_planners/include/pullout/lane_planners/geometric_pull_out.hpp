@@ -20,10 +20,9 @@
 // kerb-side lane edge; a candidate that fails is rejected as lane departure. Unlike Autoware, when
 // the rear corner's swing at R_min would cross the kerb-side edge (a car parked close to the
 // kerb), R1 is raised to the smallest radius whose swing fits with 1 cm to spare, rather than
-// giving up. Where no S
-// reaches the end pose (a start across the road: out of a perpendicular bay), the candidate is
-// two turns at R_min joined by a common tangent of the offset's length (the same way or opposite
-// ways, solve_two_turn).
+// giving up. Where no S reaches the end pose (a start across the road: out of a perpendicular
+// bay), the candidate is two turns at R_min joined by a common tangent of the offset's length (the
+// same way or opposite ways, solve_two_turn).
 //
 // Lane departure: a footprint expanded per side must stay inside the lanes (in the analytic check
 // and in the footprint check over the arcs, every 0.5 m). The road side (towards the end pose) is
