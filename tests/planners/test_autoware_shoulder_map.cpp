@@ -33,9 +33,12 @@ namespace {
 
 using namespace oracle;  // NOLINT: the test's own helpers
 
-// Shoulders passing at every possible start yaw, as measured when this test was written.
+// Shoulders passing at every possible start yaw, as measured when this test was written
+// (geometric 37; 40 on main on 2026-12-03; 42 since the S may turn towards the road first where
+// the end lies on the kerb side of the start's heading: 10988 and 10992, see solve_arc_pair; 45
+// since the widened first arc keeps 1 cm inside the kerb-side room: 1954, 10993, 13518 at +10).
 constexpr std::size_t kShiftShoulderFloor = 40;
-constexpr std::size_t kGeometricShoulderFloor = 37;
+constexpr std::size_t kGeometricShoulderFloor = 45;
 
 // [m] Neighbouring lanelets of these maps are sometimes a few centimetres apart instead of
 // sharing a bound (675 and 676 on the road_shoulder map: 4.8 cm); the lane world joins lanes whose
@@ -157,6 +160,7 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
   for (const Lanelet& shoulder : map->lanelets()) {
     if (shoulder.subtype != LaneletSubtype::kRoadShoulder) continue;
     if (!test::sampled(shoulders++)) continue;
+    if (std::getenv("SONLY") && std::to_string(shoulder.id) != std::getenv("SONLY")) continue;
     const auto c = shoulder_case(*map, shoulder);
     ASSERT_TRUE(c) << "shoulder " << shoulder.id << " has no road beside it";
     const LaneWorld own({*to_lane(shoulder)});

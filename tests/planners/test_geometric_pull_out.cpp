@@ -337,6 +337,29 @@ TEST(GeometricSingleLaneStreet, PullsOutOfEveryParallelSpotADriverWould) {
   EXPECT_GT(counts.expected_none, test::sampled_count(5));
 }
 
+// Closer to the kerb than the rear corner's swing at R_min (0.14 m with the 0.2 m rear margin):
+// the kerb-side margin yields to 0 and the first arc widens to the radius whose swing fits the gap.
+// That radius was solved for a swing equal to the gap, which rounding then put over it by 2e-16 m,
+// and the swing check refused every end pose (shoulders 10993 and 13518 of Autoware's
+// road_shoulder map turned 10 degrees towards the kerb). The street is open ahead and behind.
+TEST(GeometricSingleLaneStreet, WidensTheFirstArcJustEnoughCloserToTheKerbThanItsSwing) {
+  const VehicleInfo v;
+  const StartPlannerParameters p = family_parameters();
+  const StartPlanner planner(v, p);
+  for (const bool right_hand : {true, false}) {
+    for (int cm = 4; cm <= 13; ++cm) {
+      const Spot s{right_hand, 0.01 * cm, 20.0, 10.0};
+      const Street st = make_street(s, v);
+      const PlanningResult r = planner.plan(st.request, StopCondition());
+      ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound)
+          << s << ": " << (r.path.reasons.empty() ? "" : r.path.reasons.front());
+      // Two forward segments (the S), after a reverse where the search backed up first.
+      const std::string verdict = check_path(r.path, s, st, v, p);
+      EXPECT_TRUE(verdict.empty()) << s << ": " << verdict;
+    }
+  }
+}
+
 // The backward search on the same street with the road blocked ahead (every planner attempt
 // fails, so every start candidate shows in the evaluation table): candidates at most
 // backward_search_resolution apart, the last one just clear of the car behind, by the oracle.

@@ -106,6 +106,34 @@ TEST(ArcPair, ReachesTheEndPoseWithTheRadiiOfTheWorkedFormula) {
   EXPECT_FALSE(solve_arc_pair({0.0, 6.0, -kPi / 2}, {8.0, 0.0, 0.0}, r1, r1).has_value());
 }
 
+TEST(ArcPair, TurnsTowardsTheRoadFirstWhenAskedWhereTheEndLiesOnTheKerbSideOfTheHeading) {
+  // An S built forward: left by 0.4 rad at R1 (towards a road on the left), then right by 0.92 rad
+  // at R2 = 9.5 m; it ends turned 0.52 rad to the right and 0.106 m right of the start's heading
+  // line (a start turned towards the road, the road bending back; Autoware's shoulders 10988 and
+  // 10992). Asked to turn left first, the solver finds exactly that S again.
+  const double r1 = 5.06;
+  const double r2 = 9.5;
+  const double a = 0.4;
+  const double b = 0.92;
+  const Vec2 tangent{r1 * std::sin(a), r1 * (1.0 - std::cos(a))};
+  const Vec2 c2 = tangent + r2 * Vec2{std::sin(a), -std::cos(a)};
+  const Pose2 end{c2.x() - r2 * std::sin(a - b), c2.y() + r2 * std::cos(a - b), a - b};
+  ASSERT_LT(end.y, 0.0);  // right of the heading line: on its own, the solver turns right first
+  const auto t = solve_arc_pair({0.0, 0.0, 0.0}, end, r1, r1, 1.0);
+  ASSERT_TRUE(t.has_value());
+  const auto& arcs = t->path.pieces();
+  ASSERT_EQ(arcs.size(), 2u);
+  EXPECT_NEAR(1.0 / arcs[0].k0, r1, 1e-12);
+  EXPECT_NEAR(-1.0 / arcs[1].k0, r2, 1e-9);
+  EXPECT_NEAR(arcs[0].length, r1 * a, 1e-9);
+  EXPECT_NEAR(arcs[1].length, r2 * b, 1e-9);
+  EXPECT_NEAR(t->path.end().x, end.x, 1e-6);
+  EXPECT_NEAR(t->path.end().y, end.y, 1e-6);
+  // Without the side, the first arc turns right (towards where the end lies), not this S.
+  const auto own = solve_arc_pair({0.0, 0.0, 0.0}, end, r1, r1);
+  EXPECT_TRUE(!own.has_value() || own->path.pieces()[0].k0 < 0.0);
+}
+
 TEST(TwoTurnPath, ClothoidTurnsStayWithinTheirPeakCurvature) {
   const VehicleInfo v;
   for (double steer_deg : {5.0, 10.0, 20.0, 30.0}) {

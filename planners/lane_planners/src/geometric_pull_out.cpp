@@ -138,8 +138,12 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
   if (kerb_room > 0.0 && std::isfinite(kerb_room) &&
       corner_swing(r_min, fp.rear, kerb_side_half_width, kPi, tilt) > kerb_room) {
     // Parallel start: hypot(u, rear) <= u + room. Tilted: the swing shrinks with the radius too;
-    // raised in steps until it fits (the closed form is the first step's floor).
-    r_first = std::max(r_min, (fp.rear * fp.rear - kerb_room * kerb_room) / (2.0 * kerb_room) - kerb_side_half_width);
+    // raised in steps until it fits (the closed form is the first step's floor). The closed form
+    // aims kSwingSlack inside the room: solved for the room itself, the swing equals it and exceeds
+    // it by rounding (2e-16 m), so the check below rejected every candidate (Autoware's shoulders
+    // 10993, 13518 turned 10 degrees towards the kerb).
+    const double fit = std::max(kerb_room - kSwingSlack, 0.5 * kerb_room);
+    r_first = std::max(r_min, (fp.rear * fp.rear - fit * fit) / (2.0 * fit) - kerb_side_half_width);
     if (tilt > 0.0) {
       r_first = r_min;
       while (r_first < kMaxFirstRadius && corner_swing(r_first, fp.rear, kerb_side_half_width, kPi, tilt) > kerb_room) {
@@ -172,7 +176,11 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
     std::optional<TwoTurnPath> turns;
     const double s_end = s_base + k;
     if (!tangent_round && q >= 0.0 && s_end <= center.length()) {
-      turns = solve_arc_pair(start, center.pose_at(s_end), r_first, r_min);
+      const Pose2 end = center.pose_at(s_end);
+      turns = solve_arc_pair(start, end, r_first, r_min);
+      // The end beside the kerb side of the start's heading (a start turned towards the road,
+      // the road bending back): the S still turns towards the road first, as Autoware's.
+      if (!turns) turns = solve_arc_pair(start, end, r_first, r_min, side);
     }
     const bool arc_pair = turns.has_value();
     if (!arc_pair) {

@@ -91,7 +91,8 @@ double turning_angle(const Vec2& a, const Vec2& b, double side) {
 
 }  // namespace
 
-std::optional<TwoTurnPath> solve_arc_pair(const Pose2& start, const Pose2& end, double r1, double min_radius) {
+std::optional<TwoTurnPath> solve_arc_pair(const Pose2& start, const Pose2& end, double r1, double min_radius,
+                                          double first_side) {
   constexpr double kMinLateral = 1e-3;    // [m] an end closer to the start's line needs no S
   constexpr double kMinTurn = 1e-6;       // [rad]
   constexpr double kEndTolerance = 1e-6;  // [m] the constructed path must end on `end`
@@ -101,7 +102,8 @@ std::optional<TwoTurnPath> solve_arc_pair(const Pose2& start, const Pose2& end, 
   const Vec2 n_start = left_normal(heading(start.yaw));
   const double lateral = (e - s).dot(n_start);
   if (std::abs(lateral) < kMinLateral) return std::nullopt;
-  const double side = lateral > 0.0 ? 1.0 : -1.0;  // +1: the first arc turns left
+  // +1: the first arc turns left.
+  const double side = first_side != 0.0 ? (first_side > 0.0 ? 1.0 : -1.0) : (lateral > 0.0 ? 1.0 : -1.0);
   const Vec2 c1 = s + side * r1 * n_start;
   const Vec2 n = -side * left_normal(heading(end.yaw));  // from the end towards the second centre
   const Vec2 d = c1 - e;

@@ -6,7 +6,10 @@
 // centerline, 2 sqrt(R1^2 - (R1 - d/2)^2) ahead of the start (d: the start's lateral offset from
 // the centerline; where two arcs of R1 would end) plus an offset of 0, 1, ..., 9 m (the
 // candidates, tightest first), and the second arc's radius is solved so that the S ends exactly
-// there (solve_arc_pair): R2 = R1 at offset 0 and grows with it. A larger R2 swings the front
+// there (solve_arc_pair; the first arc turns towards the side of the start's heading line the end
+// lies on, or, where that gives no S, towards the road as Autoware's always does: a start turned
+// towards the road with the road bending back has the end on its kerb side): R2 = R1 at offset 0
+// and grows with it. A larger R2 swings the front
 // corner on the road side less far beyond the end pose (by hypot(R2 + w, front) - (R2 + w)),
 // which is what lets the vehicle pull out onto a single road lane with no opposite lane to swing
 // into.
@@ -16,10 +19,10 @@
 // edge beyond the end pose, and the rear corner on the kerb side over the first arc against the
 // kerb-side lane edge; a candidate that fails is rejected as lane departure. Unlike Autoware, when
 // the rear corner's swing at R_min would cross the kerb-side edge (a car parked close to the
-// kerb), R1 is raised to the smallest radius whose swing fits, rather than giving up. Where no S
-// reaches the end pose (a start across the road: out of a perpendicular bay), the candidate is
-// two turns at R_min joined by a common tangent of the offset's length (the same way or opposite
-// ways, solve_two_turn).
+// kerb), R1 is raised to the smallest radius whose swing fits with 1 cm to spare, rather than
+// giving up. Where no S reaches the end pose (a start across the road: out of a perpendicular
+// bay), the candidate is two turns at R_min joined by a common tangent of the offset's length (the
+// same way or opposite ways, solve_two_turn).
 //
 // Lane departure: a footprint expanded per side must stay inside the lanes (in the analytic check
 // and in the footprint check over the arcs, every 0.5 m). The road side (towards the end pose) is

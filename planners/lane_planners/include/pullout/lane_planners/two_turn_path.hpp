@@ -44,6 +44,11 @@ std::optional<TwoTurnPath> solve_two_turn(const Pose2& start, const Polyline& ce
 //   R2 = (|D|^2 - R1^2) / (2 (R1 + D . n)).
 // nullopt when the end is straight ahead of or behind the start, when no such S moving forward
 // exists (an arc would turn by pi or more, or R2 <= 0), or when R2 < `min_radius` [m].
-std::optional<TwoTurnPath> solve_arc_pair(const Pose2& start, const Pose2& end, double first_radius, double min_radius);
+// `first_side` +1 / -1 makes the first arc turn left / right whichever side of the start's heading
+// the end lies on (0: towards that side). A start already turned towards the road, with the end
+// on a road bending back the other way, lies beside the end's side of its own heading line: the S
+// that leaves it as Autoware's does still turns towards the road first, then straightens.
+std::optional<TwoTurnPath> solve_arc_pair(const Pose2& start, const Pose2& end, double first_radius, double min_radius,
+                                          double first_side = 0.0);
 
 }  // namespace pullout
