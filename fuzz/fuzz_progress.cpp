@@ -19,14 +19,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <iostream>
 #include <stdexcept>
 #include <vector>
 
-#include <fastdds/rtps/common/InstanceHandle.h>
-#include <fastdds/rtps/common/SerializedPayload.h>
-
+#include "fuzz_dds.hpp"
 #include "pullout/config/config.hpp"
 #include "pullout/config/scenario.hpp"
 #include "pullout/idl/convert.hpp"
@@ -38,8 +35,7 @@
 
 namespace {
 
-using eprosima::fastrtps::rtps::InstanceHandle_t;
-using eprosima::fastrtps::rtps::SerializedPayload_t;
+using pullout::fuzz::publish;
 
 struct Fixture {
   Fixture()
@@ -68,15 +64,6 @@ Fixture& fixture() {
   return f;
 }
 
-// What a writer does with an outgoing sample: size it, serialize it, compute its key.
-template <typename Type, typename Message>
-void publish(Type& type, Message message) {
-  SerializedPayload_t payload(type.getSerializedSizeProvider(&message)());
-  type.serialize(&message, &payload);
-  InstanceHandle_t handle;
-  type.getKey(&message, &handle, false);
-}
-
 void publish_effects(Fixture& f, const pullout::SessionEffects& effects, const char* step) {
   if (effects.path) publish(f.path_type, pullout::idl::to_msg(*effects.path));
   if (effects.status) publish(f.status_type, pullout::idl::to_msg(*effects.status));
@@ -97,15 +84,8 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   Fixture& f = fixture();
-  SerializedPayload_t payload(static_cast<std::uint32_t>(size));
-  if (size > 0) std::memcpy(payload.data, data, size);
-  payload.length = static_cast<std::uint32_t>(size);
-
   pullout::msg::ExecutionProgress sample;
-  if (!f.progress_type.deserialize(&payload, &sample)) return 0;  // the reader drops it
-  InstanceHandle_t handle;
-  if (!f.progress_type.getKey(&sample, &handle, false)) return 0;
-  if (sample.vehicle_id().size() > pullout::kMaxVehicleIdBytes) return 0;  // the service drops it
+  if (!pullout::fuzz::receive(f.progress_type, data, size, sample)) return 0;  // the reader or the service drops it
   std::vector<pullout::RequestIssue> issues;
   pullout::ExecutionProgress progress = pullout::idl::from_msg(sample, issues);
   if (!issues.empty()) {  // the service answers a conversion problem without the session

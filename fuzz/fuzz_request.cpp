@@ -17,13 +17,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <iostream>
 #include <vector>
 
-#include <fastdds/rtps/common/InstanceHandle.h>
-#include <fastdds/rtps/common/SerializedPayload.h>
-
+#include "fuzz_dds.hpp"
 #include "pullout/config/config.hpp"
 #include "pullout/idl/convert.hpp"
 #include "pullout/idl/guarded_type.hpp"
@@ -35,8 +32,7 @@
 
 namespace {
 
-using eprosima::fastrtps::rtps::InstanceHandle_t;
-using eprosima::fastrtps::rtps::SerializedPayload_t;
+using pullout::fuzz::publish;
 
 // [ms] The planning budget of every input: short, so that a run tries many inputs; the time an
 // input takes beyond it is work that ignores the stop condition.
@@ -62,15 +58,6 @@ Fixture& fixture() {
   return f;
 }
 
-// What a writer does with an outgoing sample: size it, serialize it, compute its key.
-template <typename Type, typename Message>
-void publish(Type& type, Message message) {
-  SerializedPayload_t payload(type.getSerializedSizeProvider(&message)());
-  type.serialize(&message, &payload);
-  InstanceHandle_t handle;
-  type.getKey(&message, &handle, false);
-}
-
 void publish_effects(Fixture& f, const pullout::SessionEffects& effects) {
   if (effects.path) publish(f.path_type, pullout::idl::to_msg(*effects.path));
   if (effects.status) publish(f.status_type, pullout::idl::to_msg(*effects.status));
@@ -86,15 +73,8 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   Fixture& f = fixture();
-  SerializedPayload_t payload(static_cast<std::uint32_t>(size));
-  if (size > 0) std::memcpy(payload.data, data, size);
-  payload.length = static_cast<std::uint32_t>(size);
-
   pullout::msg::PullOutRequest sample;
-  if (!f.request_type.deserialize(&payload, &sample)) return 0;  // the reader drops it
-  InstanceHandle_t handle;
-  if (!f.request_type.getKey(&sample, &handle, false)) return 0;
-  if (sample.vehicle_id().size() > pullout::kMaxVehicleIdBytes) return 0;  // the service drops it
+  if (!pullout::fuzz::receive(f.request_type, data, size, sample)) return 0;  // the reader or the service drops it
 
   std::vector<pullout::RequestIssue> issues;
   pullout::PullOutRequest request = pullout::idl::from_msg(sample, issues);
