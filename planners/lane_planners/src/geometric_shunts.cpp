@@ -233,10 +233,8 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
   double move_cap = kMaxMoveTurn / kappa;
   std::optional<PathCandidate> exit;
   std::string stuck;
-  // The manoeuvre; with `creep`, first edge away from the kerb (see kCreepTarget). False when it
-  // got stuck (`stuck` says where).
+  // 1. (of each shunt) The S from `pose`, into `exit` when one is usable.
   const auto try_exit = [&]() {
-    // 1. The S from here.
     // The candidates in order up to the first usable one (the rest are not needed when its dense
     // check passes); all of them only where it does not: the same exit as taking all at once.
     for (const double usable : {ctx.smallest_margin, kInfinity}) {
@@ -260,6 +258,8 @@ PlannerCandidates GeometricPullOut::plan_multi_move(const PlanningContext& ctx, 
       if (exit || !usable_found) break;
     }
   };
+  // The manoeuvre, with moves of at most `turn` [rad]; with `target` > 0, first edge away from the
+  // kerb to that much room (see kCreepTarget). False when it got stuck (`stuck` says where).
   const auto manoeuvre = [&](double target, double turn) {
     creep_target = target;
     move_cap = turn / kappa;

@@ -299,9 +299,9 @@ SessionEffects VehicleSession::on_progress(const ExecutionProgress& progress, Cl
   if (const std::vector<RequestIssue> issues = planner_.validate(progress); !issues.empty()) {
     // Nothing to measure or to stop from (the stop profile grows with the speed): the vehicle
     // hears why on a status of its own; the session's state is unchanged.
-    out.note = "progress ignored: " + format_issues(issues);
     out.status = status_;
     out.status->error = format_issues(issues);
+    out.note = "progress ignored: " + out.status->error;
     return out;
   }
   const Accepted current{progress.stamp_ns, now, progress.pose, progress.velocity_mps};
