@@ -23,12 +23,13 @@
 //
 // Reported: replies/s (answered requests / duration), latency p50/p99/max, lost, mismatched, not
 // planned; the service's CPU over the send window (/proc/PID/stat, % of one core) and peak RSS
-// (VmHWM); the workers' CPU; the machine's CPU busy share (/proc/stat); the workers' largest lag
-// behind their send schedule (a lag means the clients, not the service, are the limit); loopback
-// bytes per request. As root the bench re-runs itself in a network namespace of its own (as
-// bench_fleet_bytes: `ip netns add pullout-load-<pid>`, lo up, deleted at the end), so lo's
-// tx_bytes counts only this run: bytes per request = (window bytes - idle rate x window) / sent.
-// Without root (or with --no-netns) that figure is n/a.
+// (VmHWM); the workers' CPU; the machine's CPU busy share (/proc/stat) and, by second, its steal
+// (a shared VM's CPUs given to another guest: a slow second with steal is not the service's);
+// the workers' largest lag behind their send schedule (a lag means the clients, not the service,
+// are the limit); loopback bytes per request. As root the bench re-runs itself in a network
+// namespace of its own (as bench_fleet_bytes: `ip netns add pullout-load-<pid>`, lo up, deleted
+// at the end), so lo's tx_bytes counts only this run: bytes per request = (window bytes - idle
+// rate x window) / sent. Without root (or with --no-netns) that figure is n/a.
 //
 // --replicas N (N >= 1): the service as N pullout_service processes on the domain, each with
 // service.replica.enabled (N = 1: one replica-mode service; 0, the default: the plain service).
@@ -351,19 +352,33 @@ std::uint64_t cpu_ticks(pid_t pid) {
   return utime + stime;
 }
 
-// Machine CPU: (busy, total) jiffies from /proc/stat.
-std::pair<std::uint64_t, std::uint64_t> machine_jiffies() {
+// Machine CPU from /proc/stat, in jiffies: busy (user to softirq, without idle and iowait),
+// steal (time the hypervisor gave this VM's CPUs to someone else) and the total of all eight.
+struct MachineJiffies {
+  std::uint64_t busy = 0;
+  std::uint64_t steal = 0;
+  std::uint64_t total = 0;
+};
+
+MachineJiffies machine_jiffies() {
   std::ifstream in("/proc/stat");
   std::string cpu;
   in >> cpu;
+  MachineJiffies m;
   std::uint64_t v = 0;
-  std::uint64_t total = 0;
-  std::uint64_t idle = 0;
-  for (int i = 0; i < 8 && in >> v; ++i) {
-    total += v;
-    if (i == 3 || i == 4) idle += v;  // idle, iowait
+  for (int i = 0; i < 8 && in >> v; ++i) {  // user nice system idle iowait irq softirq steal
+    m.total += v;
+    if (i == 7) {
+      m.steal += v;
+    } else if (i != 3 && i != 4) {
+      m.busy += v;
+    }
   }
-  return {total - idle, total};
+  return m;
+}
+
+double share_percent(std::uint64_t part, std::uint64_t total) {
+  return 100.0 * static_cast<double>(part) / static_cast<double>(std::max<std::uint64_t>(1, total));
 }
 
 double vm_kb(pid_t pid, const std::string& key) {
@@ -578,20 +593,33 @@ int run_coordinator(const Options& o) {
   const auto machine0 = machine_jiffies();
   const std::uint64_t drops0 = udp_rcvbuf_errors();
   const std::int64_t end_ns = start_ns + static_cast<std::int64_t>(o.duration * 1e9);
-  // Per service: vehicle sessions held in mid-window (every vehicle has asked by then, and none
-  // has left: the workers delete their clients once all results are in).
-  if (!sleep_until_ns(start_ns + (end_ns - start_ns) / 2)) throw std::runtime_error("stopped by a signal");
+  // The machine's steal by second of the window: on a shared VM, a second in which the hypervisor
+  // ran someone else on these CPUs shows up as a slow second that is not the service's.
+  std::vector<double> steal_by_second;
   std::vector<double> vehicles_mid;
-  for (int r = 0; metrics && r < services_n; ++r) {
-    vehicles_mid.push_back(metric_sum(http_get(port_base + r, "/metrics"), "pullout_vehicles"));
+  bool mid_sampled = false;
+  MachineJiffies machine1 = machine0;
+  for (std::int64_t k = 1;; ++k) {
+    const std::int64_t t = std::min<std::int64_t>(end_ns, start_ns + k * 1'000'000'000);
+    if (!sleep_until_ns(t)) throw std::runtime_error("stopped by a signal");
+    const MachineJiffies now = machine_jiffies();
+    steal_by_second.push_back(share_percent(now.steal - machine1.steal, now.total - machine1.total));
+    machine1 = now;
+    // Per service: vehicle sessions held in mid-window (every vehicle has asked by then, and none
+    // has left: the workers delete their clients once all results are in).
+    if (!mid_sampled && t >= start_ns + (end_ns - start_ns) / 2) {
+      mid_sampled = true;
+      for (int r = 0; metrics && r < services_n; ++r) {
+        vehicles_mid.push_back(metric_sum(http_get(port_base + r, "/metrics"), "pullout_vehicles"));
+      }
+    }
+    if (t >= end_ns) break;
   }
-  if (!sleep_until_ns(end_ns)) throw std::runtime_error("stopped by a signal");
   const std::uint64_t bytes1 = count_bytes ? lo_tx_bytes() : 0;
   std::vector<std::uint64_t> service1;
   for (auto& sp : services) service1.push_back(cpu_ticks(sp->pid()));
   std::uint64_t workers1 = 0;
   for (auto& w : workers) workers1 += cpu_ticks(w->pid());
-  const auto machine1 = machine_jiffies();
   const std::uint64_t drops = udp_rcvbuf_errors() - drops0;
   const std::string load_after = load_text();
 
@@ -699,8 +727,8 @@ int run_coordinator(const Options& o) {
   }
   if (!metrics) spread_text = "n/a";
   const double workers_cpu = 100.0 * static_cast<double>(workers1 - workers0) / ticks / o.duration;
-  const double machine_busy = 100.0 * static_cast<double>(machine1.first - machine0.first) /
-                              static_cast<double>(std::max<std::uint64_t>(1, machine1.second - machine0.second));
+  const double machine_busy = share_percent(machine1.busy - machine0.busy, machine1.total - machine0.total);
+  const double machine_steal = share_percent(machine1.steal - machine0.steal, machine1.total - machine0.total);
   std::string bytes_text = "n/a";
   if (count_bytes && sent > 0) {
     const double window_s = static_cast<double>(end_ns - start_ns) / 1e9;
@@ -731,6 +759,9 @@ int run_coordinator(const Options& o) {
   for (const std::vector<double>& second : from_service_by_second) {
     std::printf(" %.0f", pullout::bench::summarize(second).p99);
   }
+  std::printf("\n");
+  std::printf("machine steal [%%] by second (whole window %.1f %%):", machine_steal);
+  for (const double steal : steal_by_second) std::printf(" %.0f", steal);
   std::printf("\n");
   if (metrics) {
     std::printf("replies published by the services after the drain: %.0f (requests answered: %zu)\n", replies_sum,
