@@ -160,6 +160,7 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
   for (const Lanelet& shoulder : map->lanelets()) {
     if (shoulder.subtype != LaneletSubtype::kRoadShoulder) continue;
     if (!test::sampled(shoulders++)) continue;
+    // SONLY=<lanelet id> plans that shoulder alone (when looking into one; the floors then fail).
     if (std::getenv("SONLY") && std::to_string(shoulder.id) != std::getenv("SONLY")) continue;
     const auto c = shoulder_case(*map, shoulder);
     ASSERT_TRUE(c) << "shoulder " << shoulder.id << " has no road beside it";
@@ -226,6 +227,34 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
     // curvature findings (shoulders 534, 678, 10988-10997) are reported, not asserted.
     for (const auto& f : failures[type]) EXPECT_EQ(f.find("oracle: lane departure"), std::string::npos) << f;
   }
+}
+
+// Shoulder 520 lies on the outside of a bend of about 60 degrees over 8 m of its road. With the
+// vehicle turned 10 degrees towards the road, the end pose dx = 2 sqrt(R^2 - (R - d/2)^2) along
+// the centerline lay 59 degrees round the bend, where no S of R_min reaches; the point dx ahead of
+// and d beside the start in its own frame (Autoware's) lies 35 degrees round, where Autoware's S
+// passes both its checks and stays in the shoulder and the road (bench/tools/
+// autoware_geometric_oracle.py 520 --yaw -10). Before, all 10 candidates found no S and the
+// shunting gave 12 segments.
+TEST(AutowareShoulderMap, OnABendAwayFromTheShoulderTheTwoArcsEndWhereAutowaresDo) {
+  if (!std::filesystem::exists(kMap)) {
+    GTEST_SKIP() << "skipped: " << kMap << " is absent (the shared Autoware maps beside the checkout)";
+  }
+  const auto map = load_lanelet_map(kMap);
+  const Config config = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
+  std::vector<Polygon> lanes;
+  for (const Lanelet& ll : map->lanelets()) {
+    if (auto lane = to_lane(ll)) lanes.push_back(lane_polygon(*lane));
+  }
+  const Lanelet* shoulder = nullptr;
+  for (const Lanelet& ll : map->lanelets()) {
+    if (ll.id == 520) shoulder = &ll;
+  }
+  ASSERT_NE(shoulder, nullptr);
+  const auto c = shoulder_case(*map, *shoulder);
+  ASSERT_TRUE(c);
+  const Verdict v = plan_one(*map, map, config, PlannerType::kGeometric, *c, -10.0 * kPi / 180.0, lanes);
+  EXPECT_TRUE(v.passed) << v.why;
 }
 
 // ---- a start on a road lane (Autoware pulls out from a lane's centerline too) ----

@@ -151,11 +151,19 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
       }
     }
   }
-  // The base end pose: where two arcs of r_first end on the centerline from a parallel start
-  // (Autoware's), 2 sqrt(R^2 - (R - d/2)^2) ahead; candidates move it 0..9 m further.
+  // The base end pose: where two arcs of r_first end on the centerline from a parallel start,
+  // dx = 2 sqrt(R^2 - (R - d/2)^2) ahead; candidates move it 0..9 m further. On a straight road
+  // dx along the centerline and Autoware's point (dx ahead of and d beside the start in the
+  // start's own frame, taken to the centerline) are the same place. Where the road bends away
+  // from the shoulder, the centerline's dx lies far round the bend (shoulder 520 of Autoware's
+  // map turned 10 degrees towards the road: the end 59 degrees round the bend, where no S of
+  // R_min reaches; Autoware's point is 35 degrees round, where its S does): the earlier of the two.
   const double half_offset = 0.5 * std::abs(start_on_road.lateral);
   const double q = r_first * r_first - (r_first - half_offset) * (r_first - half_offset);
-  const double s_base = start_on_road.s + 2.0 * std::sqrt(std::max(q, 0.0));
+  const double dx = 2.0 * std::sqrt(std::max(q, 0.0));
+  const Vec2 in_start_frame = to_vec(start) + dx * heading(start.yaw) +
+                              side * std::abs(start_on_road.lateral) * left_normal(heading(start.yaw));
+  const double s_base = std::clamp(center.project(in_start_frame).s, start_on_road.s, start_on_road.s + dx);
 
   // Tilted starts (a shunting manoeuvre's): after the S candidates, two turns at R_min joined by
   // a tangent of 0..9 m (which may turn away from the road first: a counter-arc onto the lane),
