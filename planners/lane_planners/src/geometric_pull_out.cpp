@@ -14,7 +14,8 @@
 namespace pullout {
 
 namespace {
-constexpr int kEndOffsets = 10;  // 0..9 m, as Autoware's end-pose offsets
+constexpr int kEndOffsets = 10;    // 0..9 m, as Autoware's end-pose offsets
+constexpr double kSameEnd = 0.25;  // [m] end poses closer along the centerline are not tried twice
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 constexpr double kEdgeReach = 50.0;  // [m] outline pieces this close to the start are looked at
@@ -151,19 +152,25 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
       }
     }
   }
-  // The base end pose: where two arcs of r_first end on the centerline from a parallel start,
-  // dx = 2 sqrt(R^2 - (R - d/2)^2) ahead; candidates move it 0..9 m further. On a straight road
-  // dx along the centerline and Autoware's point (dx ahead of and d beside the start in the
-  // start's own frame, taken to the centerline) are the same place. Where the road bends away
-  // from the shoulder, the centerline's dx lies far round the bend (shoulder 520 of Autoware's
-  // map turned 10 degrees towards the road: the end 59 degrees round the bend, where no S of
-  // R_min reaches; Autoware's point is 35 degrees round, where its S does): the earlier of the two.
+  // The end poses of the S: where two arcs of r_first end on the centerline from a parallel
+  // start, dx = 2 sqrt(R^2 - (R - d/2)^2) ahead along it, then 0..9 m further. On a straight road
+  // that is also Autoware's point (dx ahead of and d beside the start in the start's own frame,
+  // taken to the centerline). Where the road bends away from the shoulder, dx along the
+  // centerline lies far round the bend (shoulder 520 of Autoware's map, the vehicle turned 10
+  // degrees towards the road: 59 degrees round, where no S of R_min reaches); Autoware's point
+  // lies earlier (35 degrees round, where its S does). The end poses from it up to the first one
+  // along the centerline follow the 10 (tried after them, so nothing found before changes).
   const double half_offset = 0.5 * std::abs(start_on_road.lateral);
   const double q = r_first * r_first - (r_first - half_offset) * (r_first - half_offset);
   const double dx = 2.0 * std::sqrt(std::max(q, 0.0));
+  const double s_along = start_on_road.s + dx;
+  std::vector<double> s_ends;
+  for (int k = 0; k < kEndOffsets; ++k) s_ends.push_back(s_along + k);
   const Vec2 in_start_frame = to_vec(start) + dx * heading(start.yaw) +
                               side * std::abs(start_on_road.lateral) * left_normal(heading(start.yaw));
-  const double s_base = std::clamp(center.project(in_start_frame).s, start_on_road.s, start_on_road.s + dx);
+  const double s_frame = std::max(center.project(in_start_frame).s, start_on_road.s);
+  for (int k = 0; k < kEndOffsets && s_frame + k < s_along - kSameEnd; ++k) s_ends.push_back(s_frame + k);
+  const int s_rounds = static_cast<int>(s_ends.size());
 
   // Tilted starts (a shunting manoeuvre's): after the S candidates, two turns at R_min joined by
   // a tangent of 0..9 m (which may turn away from the road first: a counter-arc onto the lane),
@@ -171,27 +178,28 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
   // road lane the front corner on the road side swings over the far edge by up to
   // hypot(R + w, front) - (R + w) while the vehicle straightens (1.1 m at R_min 5.06 m, 0.64 m
   // at 10 m), so a larger radius is what fits the road's width.
-  const int rounds = turn_candidates ? (2 + static_cast<int>(kGentleTurns.size())) * kEndOffsets : kEndOffsets;
+  const int rounds = turn_candidates ? s_rounds + (1 + static_cast<int>(kGentleTurns.size())) * kEndOffsets : s_rounds;
   for (int round = 0; round < rounds; ++round) {
     out.stopped = stop.check();
     if (out.stopped != StopReason::kNone) break;
-    const bool tangent_round = round >= kEndOffsets;
-    const int k = round % kEndOffsets;
-    const int gentle = round / kEndOffsets - 2;  // index into kGentleTurns, < 0: R_min
+    const bool tangent_round = round >= s_rounds;
+    const bool earlier_end = !tangent_round && round >= kEndOffsets;  // from Autoware's point
+    const int k = tangent_round ? (round - s_rounds) % kEndOffsets : round % kEndOffsets;
+    // index into kGentleTurns, < 0: R_min
+    const int gentle = tangent_round ? (round - s_rounds) / kEndOffsets - 1 : -1;
     // An S of two arcs to the end pose on the centerline: the first arc at r_first, the second's
     // radius solved (Vorobieva). Where no S reaches it (a start across the road, out of a
     // perpendicular bay), two turns at R_min joined by a k m tangent.
     std::optional<TwoTurnPath> turns;
-    const double s_end = s_base + k;
-    if (!tangent_round && q >= 0.0 && s_end <= center.length()) {
-      const Pose2 end = center.pose_at(s_end);
+    if (!tangent_round && q >= 0.0 && s_ends[static_cast<std::size_t>(round)] <= center.length()) {
+      const Pose2 end = center.pose_at(s_ends[static_cast<std::size_t>(round)]);
       turns = solve_arc_pair(start, end, r_first, r_min);
       // The end beside the kerb side of the start's heading (a start turned towards the road,
       // the road bending back): the S still turns towards the road first, as Autoware's.
       if (!turns) turns = solve_arc_pair(start, end, r_first, r_min, side);
     }
     const bool arc_pair = turns.has_value();
-    if (!arc_pair) {
+    if (!arc_pair && !earlier_end) {  // the two turns with a k m tangent were tried in round k
       const double kappa_turn = gentle < 0 ? kappa : kappa * kGentleTurns[static_cast<std::size_t>(gentle)];
       turns = solve_two_turn(start, window, {kappa_turn, 0.0, static_cast<double>(k)});
     }
