@@ -272,6 +272,8 @@ TEST(ObstacleHeuristic, WayOverOpenGroundPointsAtTheGoalAndDoesNotTurn) {
       ASSERT_TRUE(std::isfinite(heuristic.distance(p)));
       const fd::ObstacleHeuristic::Way way = heuristic.way(p);
       ASSERT_TRUE(way.known);
+      // Room to turn: more than turning_room from the map's border.
+      if (std::min({p.x, p.y, 30.0 - p.x, 30.0 - p.y}) > config.turning_room + 0.5) EXPECT_TRUE(way.room);
       const double bearing = std::atan2(goal.y - p.y, goal.x - p.x);
       worst_bearing = std::max(worst_bearing, std::abs(normalize_angle(way.yaw - bearing)));
       worst_turning = std::max(worst_turning, way.turning);
@@ -309,6 +311,7 @@ TEST(ObstacleHeuristic, WayRoundCornersCountsTheTurningStillAhead) {
       ASSERT_TRUE(std::isfinite(heuristic.distance(p))) << x;
       const fd::ObstacleHeuristic::Way way = heuristic.way(p);
       ASSERT_TRUE(way.known) << x;
+      EXPECT_FALSE(way.room) << x;                                      // 5 m wide: less than twice turning_room
       EXPECT_LT(std::abs(normalize_angle(way.yaw)), 0.2) << "x " << x;  // along the leg, eastwards
       EXPECT_LE(way.turning, c.corners + 0.2) << "x " << x;
       EXPECT_GE(way.turning, c.corners - 0.2) << "x " << x;

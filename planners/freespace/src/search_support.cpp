@@ -334,6 +334,7 @@ ObstacleHeuristic::Way ObstacleHeuristic::way(const Pose2& p) {
   w.yaw = std::atan2(to.y() - p.y, to.x() - p.x);
   w.turning = turning_[k];
   w.known = true;
+  w.room = rate(c) <= 1.0F;
   return w;
 }
 

@@ -121,11 +121,13 @@ class ObstacleHeuristic {
   // cell's next corner, `turning` the sum of the way's turns at its corners from there to the goal
   // [rad]: a staircase of grid steps, as the shortest paths over open ground are, turns nothing,
   // and a way round a corner turns there. `known` is false where the way is not known (p's cell
-  // unreachable, or the goal's own cell: no direction).
+  // unreachable, or the goal's own cell: no direction). `room`: p's cell has room to turn (its
+  // rate is 1: no narrow charge; with narrow_penalty 0 every cell says so).
   struct Way {
     double yaw{0.0};      // [rad] map frame
     double turning{0.0};  // [rad] >= 0
     bool known{false};
+    bool room{false};
   };
   Way way(const Pose2& p);
 
