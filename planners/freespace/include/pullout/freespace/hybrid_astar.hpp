@@ -23,12 +23,13 @@
 // distance also charges extra for narrow places (narrow_heuristic_penalty): gaps the rear axle
 // fits through but the vehicle cannot turn into otherwise draw the search in.
 // With turning_heuristic_weight > 0 (off by default) the heuristic also charges, beyond the
-// Reeds-Shepp range, the turning still ahead on the Dijkstra distance's way to the goal pulled
-// taut (from the pose's heading of travel to the way's direction, then the way's corners) at
-// curve_weight x turning_radius per radian, times the reverse factor when the pose faces the way
-// backwards: the corners a reversing path still has to turn, which the distance alone does not
-// see. bench/RESULTS.md: 3x fewer expansions over the generated lots and 57x on the slow one, a
-// lower mean path cost, but more direction changes there and a 48x slower TPCAP maze (case 20).
+// Reeds-Shepp range and where the pose has room to turn, the turning still ahead on the Dijkstra
+// distance's way to the goal pulled taut (from the pose's heading of travel to the way's
+// direction, then the way's corners) at curve_weight x turning_radius per radian, times the
+// reverse factor when the pose faces the way backwards: the corners a reversing path still has to
+// turn, which the distance alone does not see. bench/RESULTS.md: 3.6x fewer expansions over the
+// generated lots (12x on the slow one) and 1.3x on TPCAP, cheaper paths with as many direction
+// changes on average, but other paths, per lot not always better.
 //
 // The pose the search expands from is known to be free, with a clearance bound kept in its node:
 // the primitives from it are only checked beyond it.
