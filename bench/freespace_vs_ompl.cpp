@@ -3,7 +3,7 @@
 //
 //   build/bench/bench_freespace [--problems 24] [--budget-ms 2000] [--seed 5] [--heuristic-weight 2.0]
 //                               [--theta-size N] [--xy-resolution M] [--narrow-penalty P] [--turning-steps S]
-//                               [--ours-only] [--no-peers] [--case N]
+//                               [--turning-heuristic W] [--ours-only] [--no-peers] [--case N]
 //
 //   build/bench/bench_freespace --tpcap ../shared/benchmarks/tpcap [--resolution 0.1] [--budget-ms 10000]
 //                               [--case N] [--min-primitive M] [--search-from-goal] [--stall-expansions N]
@@ -197,7 +197,8 @@ struct SearchOverrides {
   int turning_steps{0};
   double min_primitive{-1.0};  // < 0: the default
   bool from_goal{false};
-  long stall_expansions{-1};  // < 0: the default
+  long stall_expansions{-1};       // < 0: the default
+  double turning_heuristic{-1.0};  // < 0: the default
 } g_search;
 
 struct Run {
@@ -213,9 +214,28 @@ struct Run {
   pullout::PathShape smooth;
   double smooth_ms{0.0};
   double cpu_ms{0.0};  // the search's thread CPU time
+  double cost{0.0};    // ours: the path's cost by the search's own weights (path_cost)
   int segments{0};
   int refused{0};
 };
+
+// A path's cost by the search's weights (hybrid_astar.hpp): a step between waypoints on an arc at
+// the least turning radius costs its arc length x (1 + curve_weight), a straight step its length,
+// either times (1 + reverse_weight) in reverse, plus direction_change_weight per change. (The
+// primitives and the Reeds-Shepp shots are straight or at full steer: turning_steps 1.)
+double path_cost(const std::vector<pullout::Waypoint>& w, const pullout::HybridAStarConfig& config) {
+  double cost = 0.0;
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    const double chord = std::hypot(w[i].pose.x - w[i - 1].pose.x, w[i].pose.y - w[i - 1].pose.y);
+    const double arc = std::abs(pullout::normalize_angle(w[i].pose.yaw - w[i - 1].pose.yaw)) * config.turning_radius;
+    const bool curve = arc > 0.5 * chord;
+    double step = curve ? arc * (1.0 + config.curve_weight) : chord;
+    if (w[i].direction < 0) step *= 1.0 + config.reverse_weight;
+    cost += step;
+    if (w[i].direction != w[i - 1].direction) cost += config.direction_change_weight;
+  }
+  return cost;
+}
 
 Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, double radius, double budget_ms,
              double heuristic_weight) {
@@ -224,6 +244,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   config.xy_resolution = g_search.xy_resolution;
   if (g_search.turning_steps > 0) config.turning_steps = g_search.turning_steps;
   if (g_search.narrow_penalty >= 0.0) config.narrow_heuristic_penalty = g_search.narrow_penalty;
+  if (g_search.turning_heuristic >= 0.0) config.turning_heuristic_weight = g_search.turning_heuristic;
   if (g_search.min_primitive >= 0.0) config.min_primitive_length = g_search.min_primitive;
   if (g_search.from_goal) config.search_from_goal = true;
   if (g_search.stall_expansions >= 0) config.stall_expansions = static_cast<std::size_t>(g_search.stall_expansions);
@@ -265,6 +286,7 @@ Run run_ours(const Problem& p, const pullout::GridCollisionChecker& checker, dou
   for (std::size_t i = 1; i < r.waypoints.size(); ++i) {
     run.direction_changes += r.waypoints[i].direction != r.waypoints[i - 1].direction ? 1 : 0;
   }
+  if (run.success) run.cost = path_cost(r.waypoints, config);
   if (run.success) {
     pullout::PathSmootherConfig smoother;
     smoother.max_curvature = 1.0 / radius;
@@ -485,6 +507,8 @@ int main(int argc, char** argv) {
       g_search.turning_steps = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--narrow-penalty") == 0) {
       g_search.narrow_penalty = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--turning-heuristic") == 0) {
+      g_search.turning_heuristic = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--heuristic-weight") == 0) {
       heuristic_weight = std::atof(argv[++i]);
     } else {
@@ -546,9 +570,9 @@ int main(int argc, char** argv) {
                                                   pullout::DistanceField::kSegmentCells));
       std::printf(
           "%-18s %8.1f ms %6.1f m %2d cusps %8zu expansions  build %5.1f ms  cpu %5.1f + %5.1f ms %5.1f %% "
-          "filled%s%s\n",
+          "filled  cost %6.1f%s%s\n",
           p.name.c_str(), r.time_ms, r.length, r.direction_changes, r.expansions, p.build_ms, p.build_cpu_ms, r.cpu_ms,
-          filled, r.success ? "" : "  (no solution)", r.from_goal ? "  (from the goal)" : "");
+          filled, r.cost, r.success ? "" : "  (no solution)", r.from_goal ? "  (from the goal)" : "");
       if (!r.success) std::printf("%-18s   status %d (HybridAStarResult::Status)\n", "", r.status);
       if (p.size == 30.0 && p.resolution > 0.15 && r.success) small_ours.push_back(r.time_ms);
       continue;
@@ -603,6 +627,15 @@ int main(int argc, char** argv) {
                 fmt(percentile(solved, 0.5)).c_str(), len / n, changes / n);
   }
   if (ours_only) {
+    double cost = 0.0, solved = 0.0, expansions = 0.0;
+    for (const Run& r : runs[0]) {
+      if (!r.success) continue;
+      cost += r.cost;
+      expansions += static_cast<double>(r.expansions);
+      solved += 1.0;
+    }
+    std::printf("\nmean path cost (the search's weights) %.1f, mean expansions %.0f over %.0f solved\n",
+                cost / std::max(1.0, solved), expansions / std::max(1.0, solved), solved);
     std::printf("\ncostmap build: median %.2f ms, p95 %.2f ms, max %.2f ms; build + search: median %s ms, p95 %s ms\n",
                 percentile(builds, 0.5), percentile(builds, 0.95), percentile(builds, 1.0),
                 fmt(percentile(totals, 0.5)).c_str(), fmt(percentile(totals, 0.95)).c_str());

@@ -88,6 +88,39 @@ TEST(HybridAStar, GoalBehindAWallIsReachedAroundIt) {
   EXPECT_GT(max_y, 22.0);
 }
 
+// turning_heuristic_weight changes the order of the search, never what a path must be: around the
+// wall (the charge is added beyond the Reeds-Shepp range, 20.8 m here, so the start and most of the
+// way lie in its reach) and into a bay behind a row of cars.
+TEST(HybridAStar, PathsWithTheTurningChargeAreDrivable) {
+  HybridAStarConfig c = config();
+  c.turning_heuristic_weight = 1.0;
+  {
+    const Costmap m = walled_map(30, 30, {box(14, 0, 15, 22)});
+    const GridCollisionChecker checker(m, kCar);
+    const HybridAStar planner(checker, c);
+    const Pose2 start{5, 5, 0};
+    const HybridAStarResult r = planner.plan(start, {25, 5, 0}, StopCondition::after_ms(3000));
+    expect_drivable(checker, r, start, 5.2);
+    double max_y = 0.0;
+    for (const auto& w : r.waypoints) max_y = std::max(max_y, w.pose.y);
+    EXPECT_GT(max_y, 22.0);
+  }
+  {
+    // A 60 m lot: a row of cars along the south wall, the goal past its far end nose out (reversed
+    // into), the start 44 m away facing away from it (the charge's case: it must turn round).
+    std::vector<Polygon> cars;
+    for (double x = 4.0; x < 50.0; x += 2.7) cars.push_back(box(x, 0.2, x + 1.9, 5.0));
+    const Costmap m = walled_map(60, 20, cars);
+    const GridCollisionChecker checker(m, kCar);
+    const HybridAStar planner(checker, c);
+    const Pose2 start{10, 12, kPi};
+    const Pose2 goal{53.5, 1.5, kPi / 2};
+    const HybridAStarResult r = planner.plan(start, goal, StopCondition::after_ms(5000));
+    expect_drivable(checker, r, start, 5.2);
+    EXPECT_TRUE(r.reached_exact_goal || r.found_from_goal);
+  }
+}
+
 TEST(HybridAStar, TurningAroundInANarrowCorridorNeedsReversing) {
   // A 7 m wide corridor: a U-turn needs at least one direction change.
   const Costmap m = walled_map(40, 7.4);

@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "pullout/geometry/angle.hpp"
 #include "search_support.hpp"
 
 namespace pullout {
@@ -221,6 +222,116 @@ TEST(ObstacleHeuristic, AnswersAroundTheRootAreFinalFromTheFirstQuery) {
     }
   }
   EXPECT_GT(compared, 500);
+}
+
+// The way of ObstacleHeuristic::way: corridors 5 m wide on a 30 m map, the rest occupied.
+struct Corridor {
+  double x0, y0, x1, y1;  // [m]
+};
+
+Map corridor_map(const std::vector<Corridor>& corridors) {
+  Map m{300, 300, std::vector<std::uint8_t>(300 * 300, 1)};
+  for (int j = 0; j < m.h; ++j) {
+    for (int i = 0; i < m.w; ++i) {
+      const double x = (i + 0.5) * kRes, y = (j + 0.5) * kRes;
+      for (const Corridor& c : corridors) {
+        if (x >= c.x0 && x <= c.x1 && y >= c.y0 && y <= c.y1) m.occ[static_cast<std::size_t>(j) * m.w + i] = 0;
+      }
+    }
+  }
+  return m;
+}
+
+fd::ObstacleHeuristicConfig way_config() {
+  fd::ObstacleHeuristicConfig config;
+  config.half_width = 0.95;
+  config.cell_size = kRes * kFactor;
+  config.turning_room = 2.8;
+  config.narrow_penalty = 3.0;
+  return config;
+}
+
+// On an open map the way to the goal is a straight line whatever its slant: it points at the goal
+// and turns nothing, although the 8-connected shortest paths under it are staircases whose steps
+// go in one of eight directions, and ties between equally short ones may put every diagonal step
+// first (a bend of up to 45 degrees that the car need not turn). Independent bound: the straight
+// line from the pose to the goal (its bearing, no turn).
+TEST(ObstacleHeuristic, WayOverOpenGroundPointsAtTheGoalAndDoesNotTurn) {
+  Map m{300, 300, std::vector<std::uint8_t>(300 * 300, 0)};
+  const Costmap costmap({}, kRes, m.w, m.h, m.occ);
+  const fd::ObstacleHeuristicConfig config = way_config();
+  const Pose2 goal{15.25, 15.25, 0.0};
+  fd::ObstacleHeuristic heuristic(costmap, config, goal, Pose2{3.0, 4.0, 0.0});
+  double worst_bearing = 0.0;
+  double worst_turning = 0.0;
+  int compared = 0;
+  for (int cj = 4; cj < 56; cj += 3) {
+    for (int ci = 4; ci < 56; ci += 3) {
+      const Pose2 p{(ci + 0.5) * 0.5, (cj + 0.5) * 0.5, 0.0};
+      if (std::hypot(goal.x - p.x, goal.y - p.y) < 1.0) continue;  // (the goal's own cell)
+      ASSERT_TRUE(std::isfinite(heuristic.distance(p)));
+      const fd::ObstacleHeuristic::Way way = heuristic.way(p);
+      ASSERT_TRUE(way.known);
+      // Room to turn: more than turning_room from the map's border.
+      if (std::min({p.x, p.y, 30.0 - p.x, 30.0 - p.y}) > config.turning_room + 0.5) EXPECT_TRUE(way.room);
+      const double bearing = std::atan2(goal.y - p.y, goal.x - p.x);
+      worst_bearing = std::max(worst_bearing, std::abs(normalize_angle(way.yaw - bearing)));
+      worst_turning = std::max(worst_turning, way.turning);
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 250);
+  // The way points at the centre of the goal's cell (the goal lies in it; a quarter cell off at
+  // 1 m or more: 0.18 rad at most).
+  EXPECT_LT(worst_bearing, 0.2);
+  EXPECT_LE(worst_turning, 1e-6) << "a straight way counted as turning";
+}
+
+// Round corners: an L (one corner of 90 degrees) and a U (two). A pose on the first leg, aligned
+// with the way, has the corners still to turn; one turned away has more. Independent bound: a car
+// on the first leg must change its heading by at least the corners' sum to leave the last leg
+// towards the goal, and the way counts that much, within the grid's rounding of the corners.
+TEST(ObstacleHeuristic, WayRoundCornersCountsTheTurningStillAhead) {
+  const fd::ObstacleHeuristicConfig config = way_config();
+  struct Case {
+    std::vector<Corridor> corridors;
+    Pose2 goal;
+    double corners;  // [rad]
+  };
+  const Case cases[] = {
+      {{{1.0, 2.0, 29.0, 7.0}, {23.0, 2.0, 28.0, 29.0}}, {25.5, 27.0, kPi / 2}, kPi / 2},
+      {{{1.0, 2.0, 29.0, 7.0}, {23.0, 2.0, 28.0, 28.0}, {1.0, 23.0, 28.0, 28.0}}, {3.0, 25.5, kPi}, kPi},
+  };
+  for (const Case& c : cases) {
+    const Map m = corridor_map(c.corridors);
+    const Costmap costmap({}, kRes, m.w, m.h, m.occ);
+    fd::ObstacleHeuristic heuristic(costmap, config, c.goal, Pose2{3.0, 4.5, 0.0});
+    for (double x = 3.0; x <= 16.0; x += 0.5) {
+      const Pose2 p{x, 4.5, 0.0};
+      ASSERT_TRUE(std::isfinite(heuristic.distance(p))) << x;
+      const fd::ObstacleHeuristic::Way way = heuristic.way(p);
+      ASSERT_TRUE(way.known) << x;
+      EXPECT_FALSE(way.room) << x;                                      // 5 m wide: less than twice turning_room
+      EXPECT_LT(std::abs(normalize_angle(way.yaw)), 0.2) << "x " << x;  // along the leg, eastwards
+      EXPECT_LE(way.turning, c.corners + 0.2) << "x " << x;
+      EXPECT_GE(way.turning, c.corners - 0.2) << "x " << x;
+      // Turned away from the way: the turn back to it comes on top (facing west, a pose travels
+      // eastwards in reverse: as the aligned one).
+      const double aligned = fd::turning_ahead(way, 0.0);
+      EXPECT_NEAR(aligned, way.turning + std::abs(normalize_angle(way.yaw)), 1e-9);
+      EXPECT_LT(aligned, fd::turning_ahead(way, 0.5));
+      EXPECT_LT(aligned, fd::turning_ahead(way, -0.5));
+      EXPECT_LT(fd::turning_ahead(way, 0.5), fd::turning_ahead(way, kPi / 2));
+      EXPECT_LT(fd::turning_ahead(way, kPi / 2), fd::turning_ahead(way, kPi));
+    }
+    // On the last leg, short of the goal, nothing is left to turn.
+    const Pose2 last = c.corners > 2.0 ? Pose2{12.0, 25.5, kPi} : Pose2{25.5, 15.0, kPi / 2};
+    ASSERT_TRUE(std::isfinite(heuristic.distance(last)));
+    const fd::ObstacleHeuristic::Way way = heuristic.way(last);
+    ASSERT_TRUE(way.known);
+    EXPECT_LT(std::abs(normalize_angle(way.yaw - last.yaw)), 0.2);
+    EXPECT_LE(way.turning, 0.1);
+  }
 }
 
 }  // namespace

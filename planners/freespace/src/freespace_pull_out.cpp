@@ -120,6 +120,7 @@ HybridAStarConfig freespace_search_config(const VehicleInfo& vehicle, const Free
   c.direction_change_weight = p.search_configs.direction_change_weight;
   c.distance_heuristic_weight = p.astar.distance_heuristic_weight;
   c.narrow_heuristic_penalty = p.astar.narrow_heuristic_penalty;
+  c.turning_heuristic_weight = p.astar.turning_heuristic_weight;
   c.min_primitive_length = p.astar.min_expansion_distance;
   c.search_from_goal = p.astar.search_from_goal;
   c.stall_expansions = static_cast<std::size_t>(p.astar.stall_expansions);

@@ -179,12 +179,54 @@ class Search {
   // 20x more expansions around a wall).
   // Far from the goal the 2D distance dominates (a Reeds-Shepp path exceeds the straight line by
   // at most a few turning radii, and obstacles lengthen the 2D distance): the Reeds-Shepp term,
-  // the costliest part of an expansion, is only computed within kReedsSheppRange radii.
-  // `h2d`: the obstacle-aware distance of p (heuristic_.distance(p)).
-  double heuristic(const Pose2& p, double h2d) const {
+  // the costliest part of an expansion, is only computed within kReedsSheppRange radii. There the
+  // Reeds-Shepp distance sees the turns to the goal; the turning charge (turning_charge) is added
+  // beyond it only (added near the goal too, it cost TPCAP case 7 twelve more direction changes).
+  // `h2d`: the obstacle-aware distance of p (heuristic_.distance(p)); `direction`: see
+  // turning_charge.
+  double heuristic(const Pose2& p, double h2d, int direction) const {
     if (!std::isfinite(h2d)) return h2d;
-    if (h2d > kReedsSheppRange * config_.turning_radius) return config_.distance_heuristic_weight * h2d;
+    if (h2d > kReedsSheppRange * config_.turning_radius) {
+      return config_.distance_heuristic_weight * h2d + turning_charge(p, direction);
+    }
     return config_.distance_heuristic_weight * std::max(h2d, rs_.distance(p, target_));
+  }
+
+  // The least curve cost of the turning still ahead of p (turning_heuristic_weight > 0): from its
+  // heading of travel to the way's direction, then the way's own turning. Turning an angle takes
+  // at least turning_radius x angle of arc at full steer, which costs curve_weight per metre more
+  // than a straight primitive (times 1 + reverse_weight in reverse); the distance term charges the
+  // straight part. Without it, at distance_heuristic_weight 1 + reverse_weight a reversing path's
+  // f stays flat along its straight stretches and rises at its corners only, so every reversing
+  // pose whose detour costs less than the corners still ahead is expanded before the path ends
+  // (bench/RESULTS.md, the slow lot).
+  // The pose is taken to travel in the direction in which it faces along the way (forwards when
+  // its heading is within 90 degrees of the way's direction), plus a change of direction when that
+  // is not the direction of the primitive that led to it (`direction`; 0 at the root). Charging
+  // the primitive's own direction instead made a pose that backs out of a bay turned away from the
+  // way pay for turning round in reverse, where the path changes direction and turns forwards:
+  // that f bump flooded lots 4, 6, 16 and 24 (12,000-33,000 expansions); the cheaper of the two
+  // directions made a reversing pose turned 45 degrees off the aisle as cheap as an aligned one
+  // (the slow lot: 6,093 expansions against 693).
+  double turning_charge(const Pose2& p, int direction) const {
+    if (config_.turning_heuristic_weight <= 0.0) return 0.0;
+    const fd::ObstacleHeuristic::Way way = heuristic_.way(p);
+    // Where the cell has no room to turn (the narrow charge applies), a car turns with short moves
+    // and changes of direction, not round the way's corners at full steer: no charge there.
+    // Charged there too, a pose in a narrow pocket of TPCAP case 20 (a maze) paid for way
+    // directions that change from cell to cell: 29,874 expansions instead of 623.
+    if (!way.known || !way.room) return 0.0;
+    // The search's direction of travel (a search from the goal moves p as its primitives drive;
+    // the vehicle reverses where that differs from the search's own direction).
+    const double facing = std::abs(normalize_angle(p.yaw - way.yaw));
+    int along = facing < 0.5 * kPi ? 1 : facing > 0.5 * kPi ? -1 : (direction != 0 ? direction : 1);
+    if (!config_.use_back) along = 1;
+    const double travel = along > 0 ? p.yaw : p.yaw + kPi;
+    const double factor = (along < 0) != backward_ ? 1.0 + config_.reverse_weight : 1.0;
+    const double per_radian = config_.turning_heuristic_weight * config_.curve_weight * config_.turning_radius;
+    double charge = per_radian * factor * fd::turning_ahead(way, travel);
+    if (direction != 0 && along != direction) charge += config_.direction_change_weight;
+    return charge;
   }
 
   bool in_goal_region(const Pose2& p) const {
@@ -209,7 +251,7 @@ class Search {
       existing.closed = true;  // superseded: its heap entry is skipped when popped
     }
     const double h2d = heuristic_.distance(node.pose);
-    const double h = heuristic(node.pose, h2d);
+    const double h = heuristic(node.pose, h2d, node.direction);
     if (!std::isfinite(h)) return;
     *slot = static_cast<std::int32_t>(nodes_.size());
     nodes_.push_back(node);

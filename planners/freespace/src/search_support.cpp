@@ -4,6 +4,8 @@
 #include <cmath>
 #include <queue>
 
+#include "pullout/geometry/angle.hpp"
+
 namespace pullout::freespace_detail {
 
 Pose2 drive(const Pose2& from, double curvature, double distance) { return Arc(from, curvature).at(distance); }
@@ -159,6 +161,7 @@ ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuri
   const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
   distance_.assign(n, std::numeric_limits<float>::infinity());
   rate_.assign(n, std::numeric_limits<float>::quiet_NaN());
+  parent_.assign(n, -1);
   // A reach [cells] that proves room >= turning_room: reach cells >= turning_room, with a margin
   // for the float rounding of the distances. -1 (no shortcut) when half_width is not below
   // turning_room (the shortcut would then say nothing about blocking).
@@ -271,6 +274,7 @@ float ObstacleHeuristic::settle(std::int32_t c) {
       const float nd = d + (k < 4 ? straight : diagonal) * mean;
       if (nd < distance_[static_cast<std::size_t>(nidx)]) {
         distance_[static_cast<std::size_t>(nidx)] = nd;
+        parent_[static_cast<std::size_t>(nidx)] = idx;
         open_.push({nd + estimate(nidx), nidx});
       }
     }
@@ -308,6 +312,91 @@ double ObstacleHeuristic::distance(const Pose2& p) {
   const double d11 = at(x0 + 1, y0 + 1);
   if (!std::isfinite(d00) || !std::isfinite(d10) || !std::isfinite(d01) || !std::isfinite(d11)) return own;
   return (1.0 - ty) * ((1.0 - tx) * d00 + tx * d10) + ty * ((1.0 - tx) * d01 + tx * d11);
+}
+
+ObstacleHeuristic::Way ObstacleHeuristic::way(const Pose2& p) {
+  int i = 0;
+  int j = 0;
+  costmap_.cell_of({p.x, p.y}, i, j);
+  Way w;
+  if (!costmap_.inside(i, j)) return w;
+  const std::int32_t c = (j / factor_) * width_ + (i / factor_);
+  if (!std::isfinite(settle(c))) return w;  // (settled already when distance(p) came first)
+  if (corner_.empty()) {
+    corner_.assign(distance_.size(), -2);
+    turning_.assign(distance_.size(), 0.0F);
+  }
+  const auto k = static_cast<std::size_t>(c);
+  if (corner_[k] == -2) fill_way(c);
+  const std::int32_t corner = corner_[k];
+  if (corner == c) return w;  // the goal's cell
+  const Vec2 to = costmap_.to_map({(corner % width_ + 0.5) * factor_, (corner / width_ + 0.5) * factor_});
+  w.yaw = std::atan2(to.y() - p.y, to.x() - p.x);
+  w.turning = turning_[k];
+  w.known = true;
+  w.room = rate(c) <= 1.0F;
+  return w;
+}
+
+bool ObstacleHeuristic::visible(std::int32_t a, std::int32_t b) {
+  // Samples along the line a whole cell apart on its longer axis, and the cells on both sides of
+  // each step across the shorter one, so that the line cannot slip between two blocked cells.
+  const int ax = a % width_;
+  const int ay = a / width_;
+  const int dx = b % width_ - ax;
+  const int dy = b / width_ - ay;
+  const int n = std::max(std::abs(dx), std::abs(dy));
+  int last_x = ax;
+  int last_y = ay;
+  for (int s = 1; s <= n; ++s) {
+    const int x = ax + static_cast<int>(std::lround(static_cast<double>(dx) * s / n));
+    const int y = ay + static_cast<int>(std::lround(static_cast<double>(dy) * s / n));
+    if (std::isinf(rate(y * width_ + x))) return false;
+    if (x != last_x && y != last_y &&
+        (std::isinf(rate(last_y * width_ + x)) || std::isinf(rate(y * width_ + last_x)))) {
+      return false;
+    }
+    last_x = x;
+    last_y = y;
+  }
+  return true;
+}
+
+void ObstacleHeuristic::fill_way(std::int32_t c) {
+  // The cells ahead whose way is not known yet, then each from the goal's side: a cell's corner
+  // comes from the next cell's. Every cell ahead was taken off the open list before the cell it
+  // led to, so its distance and its own next cell are final.
+  chain_.clear();
+  for (std::int32_t x = c; x >= 0 && corner_[static_cast<std::size_t>(x)] == -2;
+       x = parent_[static_cast<std::size_t>(x)]) {
+    chain_.push_back(x);
+  }
+  const auto centre = [this](std::int32_t x) { return Vec2(x % width_, x / width_); };
+  for (auto it = chain_.rbegin(); it != chain_.rend(); ++it) {
+    const std::int32_t x = *it;
+    const auto k = static_cast<std::size_t>(x);
+    const std::int32_t next = parent_[k];
+    if (next < 0) {  // the goal's cell (the only settled cell without a next one)
+      corner_[k] = x;
+      continue;
+    }
+    const std::int32_t beyond = corner_[static_cast<std::size_t>(next)];
+    const std::int32_t corner = beyond != next && visible(x, beyond) ? beyond : next;
+    corner_[k] = corner;
+    const std::int32_t after = corner_[static_cast<std::size_t>(corner)];
+    if (after == corner) {  // straight to the goal's cell
+      turning_[k] = 0.0F;
+      continue;
+    }
+    const Vec2 in = centre(corner) - centre(x);
+    const Vec2 out = centre(after) - centre(corner);
+    const double turn = std::abs(std::atan2(in.x() * out.y() - in.y() * out.x(), in.dot(out)));
+    turning_[k] = turning_[static_cast<std::size_t>(corner)] + static_cast<float>(turn);
+  }
+}
+
+double turning_ahead(const ObstacleHeuristic::Way& way, double travel_yaw) {
+  return std::abs(normalize_angle(travel_yaw - way.yaw)) + way.turning;
 }
 
 NodeTable::NodeTable() {

@@ -115,6 +115,22 @@ class ObstacleHeuristic {
   // Distance [m] from p (map frame) to the goal; +inf when the goal cannot be reached from p.
   double distance(const Pose2& p);
 
+  // The way from p to the goal: the shortest 8-connected path of the distances above pulled taut
+  // (any-angle, as Theta* does: a cell's next corner is its next cell's corner when the straight
+  // line to it crosses no blocked cell, else its next cell). `yaw` is the direction from p to its
+  // cell's next corner, `turning` the sum of the way's turns at its corners from there to the goal
+  // [rad]: a staircase of grid steps, as the shortest paths over open ground are, turns nothing,
+  // and a way round a corner turns there. `known` is false where the way is not known (p's cell
+  // unreachable, or the goal's own cell: no direction). `room`: p's cell has room to turn (its
+  // rate is 1: no narrow charge; with narrow_penalty 0 every cell says so).
+  struct Way {
+    double yaw{0.0};      // [rad] map frame
+    double turning{0.0};  // [rad] >= 0
+    bool known{false};
+    bool room{false};
+  };
+  Way way(const Pose2& p);
+
  private:
   // The final distance of coarse cell `c`, running the search as far as that needs.
   float settle(std::int32_t c);
@@ -122,6 +138,10 @@ class ObstacleHeuristic {
   float estimate(std::int32_t c) const;
   // Per-metre cost of crossing coarse cell `c` (+inf: blocked), from its costmap cells on first use.
   float rate(std::int32_t c);
+  // Fills the way fields of settled cell `c` (and of the cells ahead of it on its way, first).
+  void fill_way(std::int32_t c);
+  // Whether the straight line between the centres of cells a and b crosses no blocked cell.
+  bool visible(std::int32_t a, std::int32_t b);
 
   const Costmap& costmap_;
   ObstacleHeuristicConfig config_;
@@ -131,8 +151,15 @@ class ObstacleHeuristic {
   double cell_size_{0.0};
   std::vector<float> distance_;
   std::vector<float> rate_;  // NaN until computed
-  int open_reach_{-1};       // [costmap cells] see rate(); -1: not used
-  int toward_x_{0};          // the coarse cell of `toward`
+  // The cell a settled cell's distance came from (its next cell on the way to the goal); -1: none.
+  std::vector<std::int32_t> parent_;
+  // Per cell, allocated on the first way(): its next corner on the taut way (-2 until computed;
+  // the goal's cell is its own) and the turning from there to the goal [rad].
+  std::vector<std::int32_t> corner_;
+  std::vector<float> turning_;
+  std::vector<std::int32_t> chain_;  // scratch of fill_way
+  int open_reach_{-1};               // [costmap cells] see rate(); -1: not used
+  int toward_x_{0};                  // the coarse cell of `toward`
   int toward_y_{0};
   using Item = std::pair<float, std::int32_t>;  // (distance + estimate, cell)
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open_;
@@ -140,6 +167,11 @@ class ObstacleHeuristic {
   StopReason stopped_{StopReason::kNone};
   std::size_t settled_{0};  // cells taken off the open list, for the stop checks
 };
+
+// The turning [rad] still ahead of a pose that moves in heading `travel_yaw` (its heading, or the
+// opposite one when it reverses) where the way to the goal is `way` (known): from its heading of
+// travel to the way's direction, then the way's own turning.
+double turning_ahead(const ObstacleHeuristic::Way& way, double travel_yaw);
 
 // Open-addressing map from a lattice key to a node index.
 class NodeTable {

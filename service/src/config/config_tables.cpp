@@ -223,6 +223,8 @@ const Table<FreespaceParameters::Astar>& astar_table() {
           field("expansion_distance", &T::expansion_distance, "m", in(0.05, 10.0), "arc length of a motion primitive"),
           field("narrow_heuristic_penalty", &T::narrow_heuristic_penalty, "", in(0.0, 100.0),
                 "(not Autoware) heuristic cost x (1 + this) where too narrow to turn; 0 = off"),
+          field("turning_heuristic_weight", &T::turning_heuristic_weight, "", in(0.0, 10.0),
+                "(not Autoware) heuristic also charges the turning still ahead, x this; 0 = off"),
           field("min_expansion_distance", &T::min_expansion_distance, "m", in(0.0, 10.0),
                 "(not Autoware) stuck search: in tight spots drive until contact, at least this far; 0 = off"),
           field("search_from_goal", &T::search_from_goal, "", AnyValue{},

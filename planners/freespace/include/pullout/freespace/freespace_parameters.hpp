@@ -40,6 +40,9 @@ struct FreespaceParameters {
     // Not in Autoware: the obstacle-aware heuristic charges up to (1 + this) per metre through
     // places narrower than the vehicle needs to turn (see hybrid_astar.hpp); 0 = plain distance.
     double narrow_heuristic_penalty{3.0};
+    // Not in Autoware: the heuristic also charges the turning still ahead on the obstacle-aware
+    // way, at this times its least curve cost (see hybrid_astar.hpp); 0 = off.
+    double turning_heuristic_weight{0.0};
     // Not in Autoware: the rescue searches of a stuck search (see hybrid_astar.hpp). At nodes in
     // a tight spot, primitives that collide are driven until contact when that is at least this
     // long [m] (0 = off, and no rescue searches at all); search_from_goal adds the search from a
