@@ -78,7 +78,16 @@ std::string oracle_problem(const PullOutPath& path, const std::vector<Polygon>& 
       }
       if (i > 0 && i + 1 < points.size()) {
         const double kappa = menger_curvature(to_vec(points[i - 1].pose), to_vec(pose), to_vec(points[i + 1].pose));
-        if (std::abs(kappa) > k_max * 1.02) return "oracle: curvature at segment " + std::to_string(k);
+        if (std::abs(kappa) > k_max * 1.02) {
+          const Pose2& prev = points[i - 1].pose;
+          const Pose2& next = points[i + 1].pose;
+          return "oracle: curvature at segment " + std::to_string(k) + " point " + std::to_string(i) + ": " +
+                 std::to_string(kappa) + " 1/m (limit " + std::to_string(k_max) + "), its neighbours " +
+                 std::to_string(std::hypot(pose.x - prev.x, pose.y - prev.y)) + " / " +
+                 std::to_string(std::hypot(next.x - pose.x, next.y - pose.y)) + " m away, " +
+                 std::to_string(std::hypot(pose.x - path.end_pose.x, pose.y - path.end_pose.y)) +
+                 " m from the end pose";
+        }
       }
       if (k + 1 == path.partial_paths.size() && std::hypot(pose.x - path.end_pose.x, pose.y - path.end_pose.y) < 1e-6) {
         return "";  // beyond the end pose the path runs on along the road's centerline

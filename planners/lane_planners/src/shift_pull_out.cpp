@@ -34,13 +34,11 @@ double push_end_to_low_curvature(const Polyline& center, double s0, double thres
   return best_s;
 }
 
-// Lateral offset l and its derivative dl/ds of the shifted path at centerline arc length s, and
-// the share w (1 at the start, 0 at the shift end) of the start residual still applied, with dw/ds.
+// Lateral offset l of the shifted path at centerline arc length s, and the share w (1 at the
+// start, 0 at the shift end) of the start residual still applied.
 struct Offset {
   double l{0.0};
-  double dl{0.0};
   double w{0.0};
-  double dw{0.0};
   Vec2 residual{Vec2::Zero()};
 };
 
@@ -59,8 +57,7 @@ class ShiftShape {
     const double time = u * profile_.total_time();
     const auto st = profile_.at(time);
     const double p = st.position / total_;
-    const double dp_du = st.velocity * profile_.total_time() / total_;
-    return {shift_length_ * (1.0 - p), -shift_length_ * dp_du / length_, 1.0 - p, -dp_du / length_, residual_};
+    return {shift_length_ * (1.0 - p), 1.0 - p, residual_};
   }
 
   double end() const { return s_begin_ + length_; }
@@ -80,27 +77,19 @@ class ShiftShape {
   Vec2 residual_{Vec2::Zero()};
 };
 
-Pose2 shifted_pose(const Polyline& center, double s, const Offset& o) {
-  const Polyline::Sample c = center.sample_at(s);
-  const Vec2 base = to_vec(c.pose);
-  const double yaw_c = c.pose.yaw;
-  const double k = c.curvature;
-  const Vec2 t = heading(yaw_c);
-  const Vec2 n = left_normal(t);
-  const Vec2 p = base + n * o.l + o.residual * o.w;
-  // Tangent of base + n(s) l(s) + r w(s): t (1 - k l) + n l' + r w'.
-  const Vec2 tangent = t * (1.0 - k * o.l) + n * o.dl + o.residual * o.dw;
-  return {p.x(), p.y(), std::atan2(tangent.y(), tangent.x())};
+Vec2 shifted_position(const Polyline& center, double s, const Offset& o) {
+  const Pose2 c = center.pose_at(s);
+  return to_vec(c) + left_normal(heading(c.yaw)) * o.l + o.residual * o.w;
 }
 
 // Path length of the shifted section over centerline length `length` from s_begin.
 double shifted_length(const Polyline& center, const ShiftShape& shape, double s_begin, double length) {
   constexpr int kSteps = 64;
   double total = 0.0;
-  Vec2 prev = to_vec(shifted_pose(center, s_begin, shape.at(s_begin)));
+  Vec2 prev = shifted_position(center, s_begin, shape.at(s_begin));
   for (int i = 1; i <= kSteps; ++i) {
     const double s = s_begin + length * i / kSteps;
-    const Vec2 p = to_vec(shifted_pose(center, s, shape.at(s)));
+    const Vec2 p = shifted_position(center, s, shape.at(s));
     total += (p - prev).norm();
     prev = p;
   }
@@ -132,9 +121,28 @@ Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, doub
     if (c.s[i] <= shape.end() + 1e-9) c.shift_end_index = i;
   }
   c.poses.reserve(c.s.size());
+  const Polyline& center = ctx.road.centerline;
   for (std::size_t i = 0; i < c.s.size() && (i == 0 || c.s[i] <= s_poses_until + 1e-9); ++i) {
-    c.poses.push_back(shifted_pose(ctx.road.centerline, c.s[i], shape.at(c.s[i])));
+    const Vec2 p = shifted_position(center, c.s[i], shape.at(c.s[i]));
+    c.poses.push_back({p.x(), p.y(), center.yaw_at(c.s[i])});
   }
+  // Headings over the shift: the direction the sampled path itself takes at each pose (the mean
+  // of the directions from the pose before and to the pose after; to the next one at the start),
+  // not t (1 - k l) + n l' from the centerline's curvature. The centerline derived from a bend
+  // drawn in coarse chords turns by 10-14 degrees within a metre at each chord's corner, and 3-4 m
+  // to the inside of such a corner k l > 1: the offset curve cusps there, within centimetres, and
+  // that formula turned the heading backwards (on Autoware's road_shoulder map, shoulders 10988,
+  // 10991, 10994: yaw 1.54 rad on a path driving at -1.6 rad, and the lane check turned the
+  // footprint with it). On the centerline (from the shift end on) its own heading stays.
+  const std::size_t last_shifted = std::min(c.shift_end_index, c.poses.size() - 1);
+  std::vector<double> yaws(last_shifted);
+  for (std::size_t i = 0; i < last_shifted; ++i) {
+    const Vec2 ahead = (to_vec(c.poses[i + 1]) - to_vec(c.poses[i])).normalized();
+    const Vec2 behind = i == 0 ? ahead : (to_vec(c.poses[i]) - to_vec(c.poses[i - 1])).normalized();
+    const Vec2 d = ahead + behind;
+    yaws[i] = d.squaredNorm() > 1e-12 ? std::atan2(d.y(), d.x()) : std::atan2(ahead.y(), ahead.x());
+  }
+  for (std::size_t i = 0; i < last_shifted; ++i) c.poses[i].yaw = yaws[i];
   return c;
 }
 
@@ -285,7 +293,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
         continue;
       }
       shape.emplace(k.profile, shift_length, s_start, s_end - s_start);
-      shape->set_residual(to_vec(start) - to_vec(shifted_pose(center, s_start, shape->at(s_start))));
+      shape->set_residual(to_vec(start) - shifted_position(center, s_start, shape->at(s_start)));
     } else {
       shape.emplace(k.profile, 0.0, s_start, 0.0);
     }
