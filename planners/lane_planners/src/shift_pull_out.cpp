@@ -77,19 +77,79 @@ class ShiftShape {
   Vec2 residual_{Vec2::Zero()};
 };
 
-Vec2 shifted_position(const Polyline& center, double s, const Offset& o) {
-  const Pose2 c = center.pose_at(s);
-  return to_vec(c) + left_normal(heading(c.yaw)) * o.l + o.residual * o.w;
+// [m] Half the length over which the reference of the shifted section is averaged, and the
+// spacing of its table (the derived centerline's own sampling).
+constexpr double kReferenceHalfWindow = 2.5;
+constexpr double kReferenceStep = 0.5;
+
+// What the shifted section is offset from: the road's centerline averaged over
+// +-kReferenceHalfWindow, tabulated along the centerline's arc length. Offsetting the centerline
+// itself point by point cusps 3-4 m inside its corners: derived from bounds drawn in coarse
+// chords it turns by 10-14 degrees within a metre at each corner (Autoware's road_shoulder map:
+// peak curvature 0.83 1/m with the start's offset held over the first 25 m beside shoulder 10988,
+// 0.28 averaged; Autoware offsets a cubic spline through a 5 m centerline). The shifted positions
+// return onto the centerline itself as the shift fades (raw - averaged, weighted by 1 - w), so the
+// path still ends on it exactly. On a straight road the average is the centerline.
+class ShiftReference {
+ public:
+  ShiftReference(const Polyline& center, double s0, double s1) : center_(center), s0_(s0) {
+    // The centerline every kReferenceStep from s0 - window to s1 + window, and a running sum over
+    // it: each entry the mean of the 2 half + 1 samples around it.
+    const auto half = static_cast<std::size_t>(std::lround(kReferenceHalfWindow / kReferenceStep));
+    const auto entries = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil((s1 - s0) / kReferenceStep)) + 1);
+    std::vector<Vec2> prefix{Vec2::Zero()};
+    prefix.reserve(entries + 2 * half + 1);
+    for (std::size_t k = 0; k < entries + 2 * half; ++k) {
+      const double s = s0 + (static_cast<double>(k) - static_cast<double>(half)) * kReferenceStep;
+      prefix.push_back(prefix.back() + center.point_at(s));
+    }
+    std::vector<Vec2> points;
+    points.reserve(entries);
+    for (std::size_t k = 0; k < entries; ++k) {
+      points.push_back((prefix[k + 2 * half + 1] - prefix[k]) / static_cast<double>(2 * half + 1));
+    }
+    averaged_ = Polyline(points);
+    // Arc length on the averaged line at each table entry (as the Polyline sums it; entries are
+    // kReferenceStep apart along the centerline, never coincident).
+    along_.reserve(points.size());
+    along_.push_back(0.0);
+    for (std::size_t k = 1; k < points.size(); ++k)
+      along_.push_back(along_.back() + (points[k] - points[k - 1]).norm());
+  }
+
+  const Polyline& center() const { return center_; }
+
+  // The averaged point at centerline arc length s and the left normal of its heading there.
+  std::pair<Vec2, Vec2> at(double s) const {
+    const double u = std::clamp((s - s0_) / kReferenceStep, 0.0, static_cast<double>(along_.size() - 1));
+    const std::size_t k = std::min(static_cast<std::size_t>(u), along_.size() - 2);
+    const double t = u - static_cast<double>(k);
+    const Pose2 q = averaged_.pose_at(along_[k] + t * (along_[k + 1] - along_[k]));
+    return {to_vec(q), left_normal(heading(q.yaw))};
+  }
+
+ private:
+  const Polyline& center_;
+  double s0_;
+  Polyline averaged_;
+  std::vector<double> along_;
+};
+
+Vec2 shifted_position(const ShiftReference& ref, double s, const Offset& o) {
+  const Vec2 raw = ref.center().point_at(s);
+  if (o.l == 0.0 && o.w == 0.0) return raw;  // beyond the shift: the centerline
+  const auto [base, normal] = ref.at(s);
+  return base + normal * o.l + o.residual * o.w + (raw - base) * (1.0 - o.w);
 }
 
 // Path length of the shifted section over centerline length `length` from s_begin.
-double shifted_length(const Polyline& center, const ShiftShape& shape, double s_begin, double length) {
+double shifted_length(const ShiftReference& ref, const ShiftShape& shape, double s_begin, double length) {
   constexpr int kSteps = 64;
   double total = 0.0;
-  Vec2 prev = shifted_position(center, s_begin, shape.at(s_begin));
+  Vec2 prev = shifted_position(ref, s_begin, shape.at(s_begin));
   for (int i = 1; i <= kSteps; ++i) {
     const double s = s_begin + length * i / kSteps;
-    const Vec2 p = shifted_position(center, s, shape.at(s));
+    const Vec2 p = shifted_position(ref, s, shape.at(s));
     total += (p - prev).norm();
     prev = p;
   }
@@ -105,8 +165,8 @@ struct Candidate {
 // Arc lengths from s_start to the path end every center_line_path_interval, with the shift end
 // included exactly; poses for those up to `s_poses_until` only (the checks need no more; the
 // winner gets the rest in extend_poses).
-Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, double s_start, const RoadEnd& end,
-                       double s_poses_until) {
+Candidate sample_poses(const PlanningContext& ctx, const ShiftReference& ref, const ShiftShape& shape, double s_start,
+                       const RoadEnd& end, double s_poses_until) {
   const double step = ctx.parameters.center_line_path_interval;
   Candidate c;
   for (double s = s_start; s < end.s - 1e-6; s += step) c.s.push_back(s);
@@ -123,17 +183,17 @@ Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, doub
   c.poses.reserve(c.s.size());
   const Polyline& center = ctx.road.centerline;
   for (std::size_t i = 0; i < c.s.size() && (i == 0 || c.s[i] <= s_poses_until + 1e-9); ++i) {
-    const Vec2 p = shifted_position(center, c.s[i], shape.at(c.s[i]));
+    const Vec2 p = shifted_position(ref, c.s[i], shape.at(c.s[i]));
     c.poses.push_back({p.x(), p.y(), center.yaw_at(c.s[i])});
   }
   // Headings over the shift: the direction the sampled path itself takes at each pose (the mean
   // of the directions from the pose before and to the pose after; to the next one at the start),
   // not t (1 - k l) + n l' from the centerline's curvature. The centerline derived from a bend
   // drawn in coarse chords turns by 10-14 degrees within a metre at each chord's corner, and 3-4 m
-  // to the inside of such a corner k l > 1: the offset curve cusps there, within centimetres, and
-  // that formula turned the heading backwards (on Autoware's road_shoulder map, shoulders 10988,
-  // 10991, 10994: yaw 1.54 rad on a path driving at -1.6 rad, and the lane check turned the
-  // footprint with it). On the centerline (from the shift end on) its own heading stays.
+  // to the inside of such a corner k l > 1: offset point by point, the curve cusped there within
+  // centimetres (ShiftReference now averages it away) and that formula turned the heading backwards (on Autoware's
+  // road_shoulder map, shoulders 10988, 10991, 10994: yaw 1.54 rad on a path driving at -1.6 rad, and the lane check
+  // turned the footprint with it). On the centerline (from the shift end on) its own heading stays.
   const std::size_t last_shifted = std::min(c.shift_end_index, c.poses.size() - 1);
   std::vector<double> yaws(last_shifted);
   for (std::size_t i = 0; i < last_shifted; ++i) {
@@ -250,6 +310,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
     return out;
   }
   const RoadEnd end = find_path_end(ctx, s_start);
+  const ShiftReference reference(center, s_start, end.s);
   const double v_road = speed_limit_at(ctx, s_start);
 
   std::vector<ShiftKinematics> kinematics;
@@ -283,7 +344,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
       // Centerline length whose shifted section is k.distance long (differs on curves).
       for (int iter = 0; iter < 2; ++iter) {
         const ShiftShape trial(k.profile, shift_length, s_start, length);
-        length *= k.distance / shifted_length(center, trial, s_start, length);
+        length *= k.distance / shifted_length(reference, trial, s_start, length);
       }
       const double s_end = push_end_to_low_curvature(center, s_start + length, params.end_pose_curvature_threshold);
       if (s_end > end.s - 1e-6) {
@@ -293,13 +354,14 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
         continue;
       }
       shape.emplace(k.profile, shift_length, s_start, s_end - s_start);
-      shape->set_residual(to_vec(start) - shifted_position(center, s_start, shape->at(s_start)));
+      shape->set_residual(to_vec(start) - shifted_position(reference, s_start, shape->at(s_start)));
     } else {
       shape.emplace(k.profile, 0.0, s_start, 0.0);
     }
     // Collision section: from the start to end_pose + shift_collision_check_distance_from_end.
     const double s_check_end = shape->end() + params.shift_collision_check_distance_from_end;
-    auto c = std::make_shared<Candidate>(sample_poses(ctx, *shape, s_start, end, std::max(shape->end(), s_check_end)));
+    auto c = std::make_shared<Candidate>(
+        sample_poses(ctx, reference, *shape, s_start, end, std::max(shape->end(), s_check_end)));
     std::size_t section_last = 0;
     while (section_last + 1 < c->s.size() && c->s[section_last + 1] <= s_check_end) ++section_last;
     check_candidate(ctx, c->poses,
