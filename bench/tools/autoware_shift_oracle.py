@@ -54,41 +54,7 @@ OUTLINE_STEP = 0.05
 
 # ---- the map as our test reads it (topology, lengths, speed limits) ----
 
-def _side_of(line, p):
-    """> 0 when p lies left of the polyline (judged at its nearest segment), < 0 right."""
-    best = (math.inf, 0.0)
-    for k in range(1, len(line)):
-        a, b = line[k - 1], line[k]
-        dx, dy = b[0] - a[0], b[1] - a[1]
-        L2 = dx * dx + dy * dy
-        if L2 <= 0:
-            continue
-        t = max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / L2))
-        d = math.dist(p, (a[0] + t * dx, a[1] + t * dy))
-        if d < best[0]:
-            best = (d, dx * (p[1] - a[1]) - dy * (p[0] - a[0]))
-    return best[1]
-
-
-def _aligned(lanelet_id):
-    """Both bounds' (points, node ids) in the driving direction: a bound drawn the other way (the
-    map has some) is reversed, each judged against the other as drawn (as the project's loader
-    and Lanelet2 do)."""
-    ll = LANELETS[lanelet_id]
-    left, right = list(WAYS[ll["left"]]), list(WAYS[ll["right"]])
-    lp, rp = [geo.NODES[i] for i in left], [geo.NODES[i] for i in right]
-    rev_right = _side_of(rp, geo.resample(lp, 2)[1]) < 0
-    rev_left = _side_of(lp, geo.resample(rp, 2)[1]) > 0
-    if rev_right:
-        right.reverse()
-        rp.reverse()
-    if rev_left:
-        left.reverse()
-        lp.reverse()
-    return {"left": lp, "right": rp, "left_nodes": left, "right_nodes": right}
-
-
-BOUNDS = {i: _aligned(i) for i in LANELETS}
+BOUNDS = geo.BOUNDS  # both bounds in the driving direction (see there)
 
 
 def _load_tags():
