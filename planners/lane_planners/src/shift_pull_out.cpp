@@ -96,7 +96,8 @@ class ShiftReference {
     // The centerline every kReferenceStep from s0 - window to s1 + window, and a running sum over
     // it: each entry the mean of the 2 half + 1 samples around it.
     const auto half = static_cast<std::size_t>(std::lround(kReferenceHalfWindow / kReferenceStep));
-    const auto entries = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil((s1 - s0) / kReferenceStep)) + 1);
+    const auto entries =
+        std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(std::max(0.0, s1 - s0) / kReferenceStep)) + 1);
     std::vector<Vec2> prefix{Vec2::Zero()};
     prefix.reserve(entries + 2 * half + 1);
     for (std::size_t k = 0; k < entries + 2 * half; ++k) {
