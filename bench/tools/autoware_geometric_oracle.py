@@ -13,7 +13,9 @@ What Autoware's planner would do from the middle of a shoulder's centerline, fro
     sampled every 1 m (arc_path_interval) as Autoware's, inside some lanelet of the whole map (the
     lanes Autoware's checker is given in the version read).
 The road is the road lanelet sharing the shoulder's bound and its road successors (first found),
-as the test's route. Usage: autoware_geometric_oracle.py [shoulder_id ...] [--yaw DEG]
+as the test's route. Bounds drawn against the driving direction (49 lanelets of this map) are
+aligned first, as Lanelet2 and the project's loader do (BOUNDS; shared with the shift script).
+Usage: autoware_geometric_oracle.py [shoulder_id ...] [--yaw DEG]
 """
 import argparse
 import math
@@ -76,14 +78,51 @@ def resample(line, n):
     return out
 
 
+def _side_of(line, p):
+    """> 0 when p lies left of the polyline (judged at its nearest segment), < 0 right."""
+    best = (math.inf, 0.0)
+    for k in range(1, len(line)):
+        a, b = line[k - 1], line[k]
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        L2 = dx * dx + dy * dy
+        if L2 <= 0:
+            continue
+        t = max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / L2))
+        d = math.dist(p, (a[0] + t * dx, a[1] + t * dy))
+        if d < best[0]:
+            best = (d, dx * (p[1] - a[1]) - dy * (p[0] - a[0]))
+    return best[1]
+
+
+def _aligned(lanelet_id):
+    """Both bounds' (points, node ids) in the driving direction: a bound drawn the other way (the
+    map has some) is reversed, each judged against the other as drawn (as the project's loader
+    and Lanelet2 do)."""
+    ll = LANELETS[lanelet_id]
+    left, right = list(WAYS[ll["left"]]), list(WAYS[ll["right"]])
+    lp, rp = [NODES[i] for i in left], [NODES[i] for i in right]
+    rev_right = _side_of(rp, resample(lp, 2)[1]) < 0
+    rev_left = _side_of(lp, resample(rp, 2)[1]) > 0
+    if rev_right:
+        right.reverse()
+        rp.reverse()
+    if rev_left:
+        left.reverse()
+        lp.reverse()
+    return {"left": lp, "right": rp, "left_nodes": left, "right_nodes": right}
+
+
+BOUNDS = {i: _aligned(i) for i in LANELETS}
+
+
 def centerline(lanelet_id, n=100):
-    a = resample(points(LANELETS[lanelet_id]["left"]), n)
-    b = resample(points(LANELETS[lanelet_id]["right"]), n)
+    a = resample(BOUNDS[lanelet_id]["left"], n)
+    b = resample(BOUNDS[lanelet_id]["right"], n)
     return [((p[0] + q[0]) / 2, (p[1] + q[1]) / 2) for p, q in zip(a, b)]
 
 
 def polygon(lanelet_id):
-    return points(LANELETS[lanelet_id]["left"]) + points(LANELETS[lanelet_id]["right"])[::-1]
+    return BOUNDS[lanelet_id]["left"] + BOUNDS[lanelet_id]["right"][::-1]
 
 
 def inside(p, poly):
@@ -132,9 +171,8 @@ def corners(pose):
 
 
 def successors(lanelet_id):
-    ll = LANELETS[lanelet_id]
-    left_end, right_end = WAYS[ll["left"]][-1], WAYS[ll["right"]][-1]
-    return [j for j, k in LANELETS.items() if WAYS[k["left"]][0] == left_end and WAYS[k["right"]][0] == right_end]
+    ends = (BOUNDS[lanelet_id]["left_nodes"][-1], BOUNDS[lanelet_id]["right_nodes"][-1])
+    return [j for j, k in BOUNDS.items() if (k["left_nodes"][0], k["right_nodes"][0]) == ends and j != lanelet_id]
 
 
 def road_beside(shoulder):
@@ -155,7 +193,7 @@ def road_beside(shoulder):
             for i in ids:
                 c = centerline(i)
                 center += c if not center else c[1:]
-                b = points(LANELETS[i]["right" if left else "left"])
+                b = BOUNDS[i]["right" if left else "left"]
                 far += b if not far else b[1:]
             return ids, center, far, left
     return None

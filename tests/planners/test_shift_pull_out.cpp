@@ -242,6 +242,63 @@ TEST(ShiftPullOut, CurvedRoadStaysWithinTheSteeringLimitAndEndsOnTheCenterline) 
   EXPECT_NEAR(seg.points.back().pose.y, req.goal_pose.y, 0.05);
 }
 
+// A road bending left through the corners of coarse chords, as on Autoware's road_shoulder map
+// (bounds drawn every 5 m, each bound with its own vertices), the shoulder on the inside: the
+// centerline derived from such bounds turns at its vertices, and 3 m to the inside of a vertex the
+// heading from the centerline's interpolated curvature, t (1 - k l), pointed backwards (shoulders
+// 10988, 10991, 10994 on that map: yaw 1.54 rad on a path driving at -1.6 rad). Every pose's
+// heading must follow the path: within 0.35 rad of the direction to the next point (a 1 m step
+// on a path whose curvature is within the vehicle's limit turns far less), never backwards.
+TEST(ShiftPullOut, HeadingFollowsThePathInsideTheCornersOfACoarseCenterline) {
+  // A straight road, a 90 degree bend to the left of centerline radius 12 m drawn in 3 m chords
+  // (each bound with its own vertices), a straight again; the shoulder on the inside.
+  const double R = 10.0;
+  const auto bend = [R](double radius) { return test::arc_points(0, R, radius, -kPi / 2, 0.0, 3.0); };
+  const auto lane = [](std::int64_t id, LaneSubtype subtype, std::vector<Point2> left, std::vector<Point2> right) {
+    Lane l;
+    l.id = id;
+    l.subtype = subtype;
+    l.left_bound = std::move(left);
+    l.right_bound = std::move(right);
+    l.speed_limit_mps = 13.89;
+    return l;
+  };
+  const std::vector<Lane> lanes = {
+      test::straight_lane(1, LaneSubtype::kRoad, -40, 0, -1.75, 1.75),
+      lane(2, LaneSubtype::kRoad, bend(R - 1.75), bend(R + 1.75)),
+      lane(3, LaneSubtype::kRoad, {{R - 1.75, R}, {R - 1.75, R + 80}}, {{R + 1.75, R}, {R + 1.75, R + 80}}),
+      test::straight_lane(11, LaneSubtype::kRoadShoulder, -40, 0, 1.75, 6.25),
+      lane(12, LaneSubtype::kRoadShoulder, bend(R - 6.25), bend(R - 1.75)),
+      lane(13, LaneSubtype::kRoadShoulder, {{R - 6.25, R}, {R - 6.25, R + 80}}, {{R - 1.75, R}, {R - 1.75, R + 80}})};
+  StartPlannerParameters params;
+  params.enable_back = false;
+  params.search_priority = {PlannerType::kShift};
+  params.freespace_planner.enable_freespace_planner = false;
+  const StartPlanner planner(VehicleInfo{}, params);
+  PullOutRequest req;
+  req.vehicle_id = "test";
+  req.request_id = 1;
+  req.lanes = lanes;
+  req.ego_pose = {-8.0, 4.0, 0.0};
+  req.goal_pose = {R, R + 70.0, kPi / 2};
+  const PlanningResult r = planner.plan(req, StopCondition());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  const PathWithLaneId& seg = r.path.partial_paths.at(0);
+  const std::size_t end_idx = index_of(seg, r.path.end_pose);
+  ASSERT_GT(end_idx, 10u);
+  // The positions do not cusp either: the curvature stays within the vehicle's limit (the bend's
+  // inside at the start's offset has a radius of about 6 m; 3.75 m inside the derived centerline's
+  // corners, offset point by point, the path reached 0.50 1/m).
+  EXPECT_LE(measure(seg, 0, end_idx).max_curvature, 1.0 / VehicleInfo{}.min_turning_radius_m());
+  for (std::size_t i = 0; i < end_idx; ++i) {
+    const Pose2& a = seg.points[i].pose;
+    const Pose2& b = seg.points[i + 1].pose;
+    const double chord = std::atan2(b.y - a.y, b.x - a.x);
+    EXPECT_LT(std::abs(normalize_angle(a.yaw - chord)), 0.35)
+        << "point " << i << " of " << end_idx << ": yaw " << a.yaw << ", towards the next point " << chord;
+  }
+}
+
 TEST(ShiftPullOut, StartOnTheCenterlineDrivesStraightOn) {
   const StartPlanner planner(VehicleInfo{}, StartPlannerParameters{});
   auto req = test::straight_shoulder_request();

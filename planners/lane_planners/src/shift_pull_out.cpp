@@ -34,13 +34,11 @@ double push_end_to_low_curvature(const Polyline& center, double s0, double thres
   return best_s;
 }
 
-// Lateral offset l and its derivative dl/ds of the shifted path at centerline arc length s, and
-// the share w (1 at the start, 0 at the shift end) of the start residual still applied, with dw/ds.
+// Lateral offset l of the shifted path at centerline arc length s, and the share w (1 at the
+// start, 0 at the shift end) of the start residual still applied.
 struct Offset {
   double l{0.0};
-  double dl{0.0};
   double w{0.0};
-  double dw{0.0};
   Vec2 residual{Vec2::Zero()};
 };
 
@@ -59,8 +57,7 @@ class ShiftShape {
     const double time = u * profile_.total_time();
     const auto st = profile_.at(time);
     const double p = st.position / total_;
-    const double dp_du = st.velocity * profile_.total_time() / total_;
-    return {shift_length_ * (1.0 - p), -shift_length_ * dp_du / length_, 1.0 - p, -dp_du / length_, residual_};
+    return {shift_length_ * (1.0 - p), 1.0 - p, residual_};
   }
 
   double end() const { return s_begin_ + length_; }
@@ -80,27 +77,80 @@ class ShiftShape {
   Vec2 residual_{Vec2::Zero()};
 };
 
-Pose2 shifted_pose(const Polyline& center, double s, const Offset& o) {
-  const Polyline::Sample c = center.sample_at(s);
-  const Vec2 base = to_vec(c.pose);
-  const double yaw_c = c.pose.yaw;
-  const double k = c.curvature;
-  const Vec2 t = heading(yaw_c);
-  const Vec2 n = left_normal(t);
-  const Vec2 p = base + n * o.l + o.residual * o.w;
-  // Tangent of base + n(s) l(s) + r w(s): t (1 - k l) + n l' + r w'.
-  const Vec2 tangent = t * (1.0 - k * o.l) + n * o.dl + o.residual * o.dw;
-  return {p.x(), p.y(), std::atan2(tangent.y(), tangent.x())};
+// [m] Half the length over which the reference of the shifted section is averaged, and the
+// spacing of its table (the derived centerline's own sampling).
+constexpr double kReferenceHalfWindow = 2.5;
+constexpr double kReferenceStep = 0.5;
+
+// What the shifted section is offset from: the road's centerline averaged over
+// +-kReferenceHalfWindow, tabulated along the centerline's arc length. Offsetting the centerline
+// itself point by point cusps 3-4 m inside its corners: derived from bounds drawn in coarse
+// chords it turns by 10-14 degrees within a metre at each corner (Autoware's road_shoulder map:
+// peak curvature 0.83 1/m with the start's offset held over the first 25 m beside shoulder 10988,
+// 0.28 averaged; Autoware offsets a cubic spline through a 5 m centerline). The shifted positions
+// return onto the centerline itself as the shift fades (raw - averaged, weighted by 1 - w), so the
+// path still ends on it exactly. On a straight road the average is the centerline.
+class ShiftReference {
+ public:
+  ShiftReference(const Polyline& center, double s0, double s1) : center_(center), s0_(s0) {
+    // The centerline every kReferenceStep from s0 - window to s1 + window, and a running sum over
+    // it: each entry the mean of the 2 half + 1 samples around it.
+    const auto half = static_cast<std::size_t>(std::lround(kReferenceHalfWindow / kReferenceStep));
+    const auto entries =
+        std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(std::max(0.0, s1 - s0) / kReferenceStep)) + 1);
+    std::vector<Vec2> prefix{Vec2::Zero()};
+    prefix.reserve(entries + 2 * half + 1);
+    for (std::size_t k = 0; k < entries + 2 * half; ++k) {
+      const double s = s0 + (static_cast<double>(k) - static_cast<double>(half)) * kReferenceStep;
+      prefix.push_back(prefix.back() + center.point_at(s));
+    }
+    std::vector<Vec2> points;
+    points.reserve(entries);
+    for (std::size_t k = 0; k < entries; ++k) {
+      points.push_back((prefix[k + 2 * half + 1] - prefix[k]) / static_cast<double>(2 * half + 1));
+    }
+    averaged_ = Polyline(points);
+    // Arc length on the averaged line at each table entry (as the Polyline sums it; entries are
+    // kReferenceStep apart along the centerline, never coincident).
+    along_.reserve(points.size());
+    along_.push_back(0.0);
+    for (std::size_t k = 1; k < points.size(); ++k)
+      along_.push_back(along_.back() + (points[k] - points[k - 1]).norm());
+  }
+
+  const Polyline& center() const { return center_; }
+
+  // The averaged point at centerline arc length s and the left normal of its heading there.
+  std::pair<Vec2, Vec2> at(double s) const {
+    const double u = std::clamp((s - s0_) / kReferenceStep, 0.0, static_cast<double>(along_.size() - 1));
+    const std::size_t k = std::min(static_cast<std::size_t>(u), along_.size() - 2);
+    const double t = u - static_cast<double>(k);
+    const Pose2 q = averaged_.pose_at(along_[k] + t * (along_[k + 1] - along_[k]));
+    return {to_vec(q), left_normal(heading(q.yaw))};
+  }
+
+ private:
+  const Polyline& center_;
+  double s0_;
+  Polyline averaged_;
+  std::vector<double> along_;
+};
+
+Vec2 shifted_position(const ShiftReference& ref, double s, const Offset& o) {
+  const Vec2 raw = ref.center().point_at(s);
+  if (o.l == 0.0 && o.w == 0.0) return raw;  // beyond the shift: the centerline
+  const auto [base, normal] = ref.at(s);
+  return base + normal * o.l + o.residual * o.w + (raw - base) * (1.0 - o.w);
 }
 
 // Path length of the shifted section over centerline length `length` from s_begin.
-double shifted_length(const Polyline& center, const ShiftShape& shape, double s_begin, double length) {
+double shifted_length(const ShiftReference& ref, const ShiftShape& shape, double s_begin, double length) {
   constexpr int kSteps = 64;
   double total = 0.0;
-  Vec2 prev = to_vec(shifted_pose(center, s_begin, shape.at(s_begin)));
+  Vec2 prev = shifted_position(ref, s_begin, shape.at(s_begin));
   for (int i = 1; i <= kSteps; ++i) {
     const double s = s_begin + length * i / kSteps;
-    const Vec2 p = to_vec(shifted_pose(center, s, shape.at(s)));
+    const Vec2 p = shifted_position(ref, s, shape.at(s));
     total += (p - prev).norm();
     prev = p;
   }
@@ -116,8 +166,8 @@ struct Candidate {
 // Arc lengths from s_start to the path end every center_line_path_interval, with the shift end
 // included exactly; poses for those up to `s_poses_until` only (the checks need no more; the
 // winner gets the rest in extend_poses).
-Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, double s_start, const RoadEnd& end,
-                       double s_poses_until) {
+Candidate sample_poses(const PlanningContext& ctx, const ShiftReference& ref, const ShiftShape& shape, double s_start,
+                       const RoadEnd& end, double s_poses_until) {
   const double step = ctx.parameters.center_line_path_interval;
   Candidate c;
   for (double s = s_start; s < end.s - 1e-6; s += step) c.s.push_back(s);
@@ -132,9 +182,28 @@ Candidate sample_poses(const PlanningContext& ctx, const ShiftShape& shape, doub
     if (c.s[i] <= shape.end() + 1e-9) c.shift_end_index = i;
   }
   c.poses.reserve(c.s.size());
+  const Polyline& center = ctx.road.centerline;
   for (std::size_t i = 0; i < c.s.size() && (i == 0 || c.s[i] <= s_poses_until + 1e-9); ++i) {
-    c.poses.push_back(shifted_pose(ctx.road.centerline, c.s[i], shape.at(c.s[i])));
+    const Vec2 p = shifted_position(ref, c.s[i], shape.at(c.s[i]));
+    c.poses.push_back({p.x(), p.y(), center.yaw_at(c.s[i])});
   }
+  // Headings over the shift: the direction the sampled path itself takes at each pose (the mean
+  // of the directions from the pose before and to the pose after; to the next one at the start),
+  // not t (1 - k l) + n l' from the centerline's curvature. The centerline derived from a bend
+  // drawn in coarse chords turns by 10-14 degrees within a metre at each chord's corner, and 3-4 m
+  // to the inside of such a corner k l > 1: offset point by point, the curve cusped there within
+  // centimetres (ShiftReference now averages it away) and that formula turned the heading backwards (on Autoware's
+  // road_shoulder map, shoulders 10988, 10991, 10994: yaw 1.54 rad on a path driving at -1.6 rad, and the lane check
+  // turned the footprint with it). On the centerline (from the shift end on) its own heading stays.
+  const std::size_t last_shifted = std::min(c.shift_end_index, c.poses.size() - 1);
+  std::vector<double> yaws(last_shifted);
+  for (std::size_t i = 0; i < last_shifted; ++i) {
+    const Vec2 ahead = (to_vec(c.poses[i + 1]) - to_vec(c.poses[i])).normalized();
+    const Vec2 behind = i == 0 ? ahead : (to_vec(c.poses[i]) - to_vec(c.poses[i - 1])).normalized();
+    const Vec2 d = ahead + behind;
+    yaws[i] = d.squaredNorm() > 1e-12 ? std::atan2(d.y(), d.x()) : std::atan2(ahead.y(), ahead.x());
+  }
+  for (std::size_t i = 0; i < last_shifted; ++i) c.poses[i].yaw = yaws[i];
   return c;
 }
 
@@ -242,6 +311,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
     return out;
   }
   const RoadEnd end = find_path_end(ctx, s_start);
+  const ShiftReference reference(center, s_start, end.s);
   const double v_road = speed_limit_at(ctx, s_start);
 
   std::vector<ShiftKinematics> kinematics;
@@ -275,7 +345,7 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
       // Centerline length whose shifted section is k.distance long (differs on curves).
       for (int iter = 0; iter < 2; ++iter) {
         const ShiftShape trial(k.profile, shift_length, s_start, length);
-        length *= k.distance / shifted_length(center, trial, s_start, length);
+        length *= k.distance / shifted_length(reference, trial, s_start, length);
       }
       const double s_end = push_end_to_low_curvature(center, s_start + length, params.end_pose_curvature_threshold);
       if (s_end > end.s - 1e-6) {
@@ -285,13 +355,14 @@ PlannerCandidates ShiftPullOut::plan(const PlanningContext& ctx, const Pose2& st
         continue;
       }
       shape.emplace(k.profile, shift_length, s_start, s_end - s_start);
-      shape->set_residual(to_vec(start) - to_vec(shifted_pose(center, s_start, shape->at(s_start))));
+      shape->set_residual(to_vec(start) - shifted_position(reference, s_start, shape->at(s_start)));
     } else {
       shape.emplace(k.profile, 0.0, s_start, 0.0);
     }
     // Collision section: from the start to end_pose + shift_collision_check_distance_from_end.
     const double s_check_end = shape->end() + params.shift_collision_check_distance_from_end;
-    auto c = std::make_shared<Candidate>(sample_poses(ctx, *shape, s_start, end, std::max(shape->end(), s_check_end)));
+    auto c = std::make_shared<Candidate>(
+        sample_poses(ctx, reference, *shape, s_start, end, std::max(shape->end(), s_check_end)));
     std::size_t section_last = 0;
     while (section_last + 1 < c->s.size() && c->s[section_last + 1] <= s_check_end) ++section_last;
     check_candidate(ctx, c->poses,

@@ -21,6 +21,14 @@
 // - The lateral offset is the exact piecewise-cubic constant-jerk profile mapped linearly from
 //   time to arc length, not a spline through knot points, so it cannot overshoot and no
 //   refinement iterations are needed; the path starts exactly at the start pose.
+// - The shifted section is offset from the road centerline averaged over +-2.5 m (blended back
+//   onto the centerline itself as the shift fades), not from the centerline point by point: a
+//   centerline derived from bounds drawn in coarse chords turns 10-14 degrees within a metre at
+//   each corner, and 3-4 m inside such a corner the offset cusped (curvature 0.5-1.3 1/m).
+//   Autoware offsets a cubic spline through a 5 m centerline.
+// - Each shifted pose's heading is the direction the sampled path takes there (the mean of the
+//   directions from the pose before and to the pose after), as Autoware's are (the azimuth to the
+//   next point), not one from the centerline's curvature (which pointed backwards at such cusps).
 // - v_term = sqrt(2 a_lon d) keeps the pair consistent when the curvature term sets d (it equals
 //   a_lon T otherwise).
 // - The static collision check is never skipped (Autoware skips it for shifts < 0.5 m and ignores
