@@ -329,8 +329,11 @@ ObstacleHeuristic::Way ObstacleHeuristic::way(const Pose2& p) {
   const auto k = static_cast<std::size_t>(c);
   if (corner_[k] == -2) fill_way(c);
   const std::int32_t corner = corner_[k];
-  if (corner == c) return w;  // the goal's cell
-  const Vec2 to = costmap_.to_map({(corner % width_ + 0.5) * factor_, (corner / width_ + 0.5) * factor_});
+  if (corner == c) return w;                 // the goal's cell
+  const std::int32_t row = corner / width_;  // integer division: the corner cell's row
+  const std::int32_t col = corner % width_;
+  const Vec2 to =
+      costmap_.to_map({(static_cast<double>(col) + 0.5) * factor_, (static_cast<double>(row) + 0.5) * factor_});
   w.yaw = std::atan2(to.y() - p.y, to.x() - p.x);
   w.turning = turning_[k];
   w.known = true;

@@ -165,6 +165,7 @@ PlannerCandidates arc_pair_candidates(const PlanningContext& ctx, const Pose2& s
   const double dx = 2.0 * std::sqrt(std::max(q, 0.0));
   const double s_along = start_on_road.s + dx;
   std::vector<double> s_ends;
+  s_ends.reserve(2 * static_cast<std::size_t>(kEndOffsets));
   for (int k = 0; k < kEndOffsets; ++k) s_ends.push_back(s_along + k);
   const Vec2 in_start_frame = to_vec(start) + dx * heading(start.yaw) +
                               side * std::abs(start_on_road.lateral) * left_normal(heading(start.yaw));

@@ -137,7 +137,7 @@ class ShiftReference {
 };
 
 Vec2 shifted_position(const ShiftReference& ref, double s, const Offset& o) {
-  const Vec2 raw = ref.center().point_at(s);
+  Vec2 raw = ref.center().point_at(s);
   if (o.l == 0.0 && o.w == 0.0) return raw;  // beyond the shift: the centerline
   const auto [base, normal] = ref.at(s);
   return base + normal * o.l + o.residual * o.w + (raw - base) * (1.0 - o.w);
