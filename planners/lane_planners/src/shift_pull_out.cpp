@@ -192,9 +192,10 @@ Candidate sample_poses(const PlanningContext& ctx, const ShiftReference& ref, co
   // not t (1 - k l) + n l' from the centerline's curvature. The centerline derived from a bend
   // drawn in coarse chords turns by 10-14 degrees within a metre at each chord's corner, and 3-4 m
   // to the inside of such a corner k l > 1: offset point by point, the curve cusped there within
-  // centimetres (ShiftReference now averages it away) and that formula turned the heading backwards (on Autoware's
-  // road_shoulder map, shoulders 10988, 10991, 10994: yaw 1.54 rad on a path driving at -1.6 rad, and the lane check
-  // turned the footprint with it). On the centerline (from the shift end on) its own heading stays.
+  // centimetres (ShiftReference now averages it away) and that formula turned the heading
+  // backwards (on Autoware's road_shoulder map, shoulders 10988, 10991, 10994: yaw 1.54 rad on a
+  // path driving at -1.6 rad, and the lane check turned the footprint with it). On the centerline
+  // (from the shift end on) its own heading stays.
   const std::size_t last_shifted = std::min(c.shift_end_index, c.poses.size() - 1);
   std::vector<double> yaws(last_shifted);
   for (std::size_t i = 0; i < last_shifted; ++i) {
