@@ -263,18 +263,25 @@ def lanelets_at(p):
     return [i for i, b in BOXES.items() if b[0] <= p[0] <= b[2] and b[1] <= p[1] <= b[3] and geo.inside(p, POLYS[i])]
 
 
+def distance_to_outline(poly, p):
+    """Distance from p to the closed outline of polygon `poly` (its edges, not its inside)."""
+    best = math.inf
+    for k in range(len(poly)):
+        a, c = poly[k - 1], poly[k]
+        dx, dy = c[0] - a[0], c[1] - a[1]
+        L2 = dx * dx + dy * dy
+        t = 0.0 if L2 == 0 else max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / L2))
+        best = min(best, math.dist(p, (a[0] + t * dx, a[1] + t * dy)))
+    return best
+
+
 def distance_to_lanelets(p):
     best = math.inf
     for i, b in BOXES.items():
         if p[0] < b[0] - best or p[0] > b[2] + best or p[1] < b[1] - best or p[1] > b[3] + best:
             continue
         poly = POLYS[i]
-        for k in range(len(poly)):
-            a, c = poly[k - 1], poly[k]
-            dx, dy = c[0] - a[0], c[1] - a[1]
-            L2 = dx * dx + dy * dy
-            t = 0.0 if L2 == 0 else max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / L2))
-            best = min(best, math.dist(p, (a[0] + t * dx, a[1] + t * dy)))
+        best = min(best, distance_to_outline(poly, p))
     return best
 
 
@@ -541,15 +548,7 @@ def evaluate(shoulder, yaw_deg, verbose=True):
 def distance_to_lanelet(lanelet_id, p):
     if geo.inside(p, POLYS[lanelet_id]):
         return 0.0
-    poly = POLYS[lanelet_id]
-    best = math.inf
-    for k in range(len(poly)):
-        a, c = poly[k - 1], poly[k]
-        dx, dy = c[0] - a[0], c[1] - a[1]
-        L2 = dx * dx + dy * dy
-        t = 0.0 if L2 == 0 else max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / L2))
-        best = min(best, math.dist(p, (a[0] + t * dx, a[1] + t * dy)))
-    return best
+    return distance_to_outline(POLYS[lanelet_id], p)
 
 
 def arc_coordinates(line, p):
