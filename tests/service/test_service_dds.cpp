@@ -258,13 +258,15 @@ class TestClient {
     auto* sub = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
     request_writer_ = pub->create_datawriter_with_profile(request_topic, "pullout_request_writer");
     progress_writer_ = pub->create_datawriter_with_profile(progress_topic, "pullout_progress_writer");
-    auto* path_reader = sub->create_datareader(path_topic, deep_reader_qos(sub, "pullout_path_reader"));
-    auto* status_reader = sub->create_datareader(status_topic, deep_reader_qos(sub, "pullout_status_reader"));
-    if (!request_writer_ || !progress_writer_ || !path_reader || !status_reader) throw std::runtime_error("entities");
+    path_reader_ = sub->create_datareader(path_topic, deep_reader_qos(sub, "pullout_path_reader"));
+    status_reader_ = sub->create_datareader(status_topic, deep_reader_qos(sub, "pullout_status_reader"));
+    if (!request_writer_ || !progress_writer_ || !path_reader_ || !status_reader_) {
+      throw std::runtime_error("entities");
+    }
     paths = std::make_unique<Inbox<msg::PullOutPath, PullOutPath>>(
-        path_reader, [](const msg::PullOutPath& m) { return idl::from_msg(m); });
+        path_reader_, [](const msg::PullOutPath& m) { return idl::from_msg(m); });
     statuses = std::make_unique<Inbox<msg::PullOutStatus, PullOutStatus>>(
-        status_reader, [](const msg::PullOutStatus& m) { return idl::from_msg(m); });
+        status_reader_, [](const msg::PullOutStatus& m) { return idl::from_msg(m); });
   }
 
   ~TestClient() {
@@ -274,15 +276,25 @@ class TestClient {
     dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
   }
 
-  // Waits until the service's readers and writers are matched.
+  // Waits until the service's readers and writers are matched, both ways. Discovery is not
+  // symmetric: the service may read this client's requests before its status writer knows this
+  // client's reader, and a status written then reaches the reader only as the writer's history
+  // (the latest sample per vehicle), so a `planning` followed by the answer would arrive as the
+  // answer alone.
   bool wait_matched(std::chrono::milliseconds timeout = std::chrono::milliseconds(15000)) {
     const auto until = Clock::now() + timeout;
     while (Clock::now() < until) {
       dds::PublicationMatchedStatus req;
       dds::PublicationMatchedStatus prog;
+      dds::SubscriptionMatchedStatus path;
+      dds::SubscriptionMatchedStatus status;
       request_writer_->get_publication_matched_status(req);
       progress_writer_->get_publication_matched_status(prog);
-      if (req.current_count >= 1 && prog.current_count >= 1) return true;
+      path_reader_->get_subscription_matched_status(path);
+      status_reader_->get_subscription_matched_status(status);
+      if (req.current_count >= 1 && prog.current_count >= 1 && path.current_count >= 1 && status.current_count >= 1) {
+        return true;
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     return false;
@@ -363,6 +375,8 @@ class TestClient {
   dds::DataWriter* garbage_progress_writer_{nullptr};
   dds::DataWriter* request_writer_{nullptr};
   dds::DataWriter* progress_writer_{nullptr};
+  dds::DataReader* path_reader_{nullptr};
+  dds::DataReader* status_reader_{nullptr};
 };
 
 PullOutRequest scenario_request(const std::string& name, const std::string& vehicle, std::uint64_t request_id) {
