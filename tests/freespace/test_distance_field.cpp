@@ -78,6 +78,49 @@ TEST(DistanceField, MatchesBruteForceOnRandomMaps) {
   }
 }
 
+// The capped squared distances of a row range: exact below (cap + 1)^2, at least that beyond.
+// Ranges at the grid's left and right edges (the border columns inside the window) and inside;
+// caps of one cell, of a few, and the largest allowed; grids narrower than the window.
+TEST(DistanceField, CappedSquaredIsExactBelowTheCapAndAtLeastItBeyond) {
+  std::mt19937 rng(17);
+  const std::pair<int, int> sizes[] = {{300, 40}, {20, 30}, {1, 12}, {257, 9}};
+  int exact = 0;
+  int capped = 0;
+  for (const auto& [w, h] : sizes) {
+    for (const double density : {0.0, 0.01, 0.3}) {
+      const Grid g = random_grid(w, h, density, rng);
+      DistanceField field;
+      ASSERT_EQ(field.build(g.occupied.data(), g.width, g.height, 0.1), StopReason::kNone);
+      for (const int cap : {1, 3, 29, DistanceField::kMaxCap}) {
+        std::uniform_int_distribution<int> length(1, std::min(w, DistanceField::kMaxCappedCells));
+        for (int k = 0; k < 6; ++k) {
+          const int n = length(rng);
+          const int x0 = k == 0 ? 0 : k == 1 ? w - n : std::uniform_int_distribution<int>(0, w - n)(rng);
+          const int iy = std::uniform_int_distribution<int>(0, h - 1)(rng);
+          std::vector<std::int16_t> out(static_cast<std::size_t>(n));
+          field.capped_squared(iy, x0, x0 + n, cap, out.data(), g.occupied.data());
+          for (int i = 0; i < n; ++i) {
+            const std::int64_t truth = oracle_squared(g, x0 + i, iy);
+            const std::int64_t got = out[static_cast<std::size_t>(i)];
+            SCOPED_TRACE(testing::Message() << w << "x" << h << " density " << density << " cap " << cap << " cell "
+                                            << x0 + i << "," << iy);
+            if (truth < std::int64_t{cap + 1} * (cap + 1)) {
+              ASSERT_EQ(got, truth);
+              ++exact;
+            } else {
+              ASSERT_GE(got, std::int64_t{cap + 1} * (cap + 1));
+              ++capped;
+            }
+          }
+        }
+      }
+    }
+  }
+  // Both kinds of cell were compared many times.
+  EXPECT_GT(exact, 1000);
+  EXPECT_GT(capped, 1000);
+}
+
 TEST(DistanceField, MatchesBruteForceAroundLongWalls) {
   // Walls with gaps and a large open room: the nearest obstacle of many cells lies far along the
   // row, beyond their segment.

@@ -134,6 +134,54 @@ void DistanceField::fill(int ix, int iy, std::size_t segment, const std::uint8_t
   });
 }
 
+namespace {
+
+// The least of dx^2 + min(g(x + dx), cap + 1)^2 over |dx| <= cap for x = x0 .. x1 - 1 of a row
+// (g: the row's first pass, `width` columns; columns -1 and width occupied) into out[0 .. x1 - x0):
+// exact where the squared distance is below (cap + 1)^2, at least (cap + 1)^2 where it is not
+// (0 < x1 - x0 <= DistanceField::kMaxCappedCells, 1 <= cap <= DistanceField::kMaxCap). The nearest
+// occupied cell less than cap + 1 away lies in a column within cap, at a row distance of its
+// column's g (at most cap): that term is exact, and every other term is a true squared distance or above
+// (cap + 1)^2. 16-bit lanes: (cap + 1)^2 + cap^2 fits.
+void brute_force_row(const std::uint16_t* g, int width, int x0, int x1, int cap, std::int16_t* out) {
+  std::array<std::int16_t, DistanceField::kMaxCappedCells + 2 * DistanceField::kMaxCap> sq;
+  const auto far = static_cast<std::int16_t>((cap + 1) * (cap + 1));
+  const int lo = x0 - cap;  // sq[k - lo] for the columns k = lo .. x1 - 1 + cap
+  const int hi = x1 + cap;
+  // The columns beyond -1 and width are never nearer than those two (occupied): `far`.
+  const int in0 = std::max(lo, 0);
+  const int in1 = std::min(hi, width);
+  for (int k = lo; k < in0; ++k) sq[static_cast<std::size_t>(k - lo)] = k == -1 ? 0 : far;
+  const auto limit = static_cast<std::uint16_t>(cap + 1);
+  std::int16_t* inner = sq.data() + (in0 - lo);
+  const std::uint16_t* column = g + in0;
+  for (int k = 0; k < in1 - in0; ++k) {
+    const int c = std::min(column[k], limit);
+    inner[k] = static_cast<std::int16_t>(c * c);
+  }
+  for (int k = in1; k < hi; ++k) sq[static_cast<std::size_t>(k - lo)] = k == width ? 0 : far;
+  const int n = x1 - x0;
+  const std::int16_t* mid = sq.data() + cap;
+  std::copy(mid, mid + n, out);
+  for (int dx = 1; dx <= cap; ++dx) {
+    const auto add = static_cast<std::int16_t>(dx * dx);
+    const std::int16_t* right = mid + dx;
+    const std::int16_t* left = mid - dx;
+    for (int i = 0; i < n; ++i) {
+      out[i] = std::min(out[i], static_cast<std::int16_t>(std::min(left[i], right[i]) + add));
+    }
+  }
+}
+
+}  // namespace
+
+void DistanceField::capped_squared(int iy, int x0, int x1, int cap, std::int16_t* out,
+                                   const std::uint8_t* occupied) const {
+  bands_.ensure(static_cast<std::size_t>(iy >> kBandShift), [&] { fill_band(iy >> kBandShift, occupied); });
+  brute_force_row(column_.data() + static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_), width_, x0, x1, cap,
+                  out);
+}
+
 void DistanceField::row_segment(int iy, int x0, int x1, float* out) const {
   const std::uint16_t* g = column_.data() + static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_);
   // The columns -1 and width are occupied (distance 0 in every row).
@@ -168,6 +216,17 @@ void DistanceField::row_segment(int iy, int x0, int x1, float* out) const {
   for (int k = x1 - 1; k >= x0; --k) {
     if (k < x1 - 1) run = std::min<std::int64_t>(run + 1, g[k]);
     reach = std::max(reach, std::min({run, forward[k - x0], std::int64_t{k} + 1, std::int64_t{width_} - k}));
+  }
+  if (reach <= kBruteForceReach) {
+    // Every cell lies at most `reach` from an occupied one: the brute force capped there is exact
+    // for all of them, and cheaper than the envelope below while the reach is short.
+    std::array<std::int16_t, kSegmentCells> d2;
+    brute_force_row(g, width_, x0, x1, static_cast<int>(std::max<std::int64_t>(reach, 1)), d2.data());
+    for (int x = x0; x < x1; ++x) {
+      out[x - x0] =
+          static_cast<float>(std::sqrt(static_cast<double>(d2[static_cast<std::size_t>(x - x0)])) * resolution_);
+    }
+    return;
   }
   const int lo = static_cast<int>(std::max<std::int64_t>(-1, x0 - reach));
   const int hi = static_cast<int>(std::min<std::int64_t>(width_, x1 - 1 + reach));

@@ -1,6 +1,7 @@
 #include "search_support.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <queue>
 
@@ -169,6 +170,16 @@ ObstacleHeuristic::ObstacleHeuristic(const Costmap& costmap, const ObstacleHeuri
   if (config.half_width < config.turning_room && reach_cells >= 0.0 && reach_cells < 1e6) {
     open_reach_ = static_cast<int>(reach_cells);
   }
+  // The rooms from distances capped a cell beyond the larger of turning_room and half_width: a
+  // room beyond the cap has room to turn (rate 1) and is not blocked, whatever its exact value.
+  const double cap_cells = std::ceil(std::max(config.turning_room, config.half_width) / costmap.resolution()) + 1.0;
+  if (cap_cells >= 1.0 && cap_cells <= DistanceField::kMaxCap &&
+      factor_ * kRoomTile <= DistanceField::kMaxCappedCells) {
+    room_cap_ = static_cast<int>(cap_cells);
+    room_tiles_per_row_ = (width_ + kRoomTile - 1) / kRoomTile;
+    room2_.assign(n, 0);
+    room_tile_ready_.assign(static_cast<std::size_t>(room_tiles_per_row_) * static_cast<std::size_t>(height_), 0);
+  }
   int ti = 0;
   int tj = 0;
   costmap.cell_of({toward.x, toward.y}, ti, tj);
@@ -227,17 +238,50 @@ float ObstacleHeuristic::rate(std::int32_t c) {
   }
   bool blocked = true;
   double room = 0.0;
-  for (int j = j0; j < j1; ++j) {
-    for (int i = i0; i < i1; ++i) {
-      if (costmap_.occupied(i, j)) continue;
-      const double d = costmap_.centre_distance(i, j);
-      room = std::max(room, d);
-      if (d + slack >= config_.half_width) blocked = false;
+  if (room_cap_ >= 0) {
+    // The same room and verdict as the scan below: the largest squared distance of the cell's
+    // costmap cells, rounded as the distance field rounds each (a monotone rounding: the largest
+    // rounded is the rounded largest). It is exact up to the cap, and beyond it the rate is 1
+    // and the cell not blocked either way. A free costmap cell lies at least a cell from an
+    // occupied one: 0 means that all of them are occupied (blocked, as the scan finds).
+    const std::int32_t tile = (c / width_) * room_tiles_per_row_ + (c % width_) / kRoomTile;
+    if (room_tile_ready_[static_cast<std::size_t>(tile)] == 0) fill_room_tile(tile);
+    const std::int16_t m = room2_[static_cast<std::size_t>(c)];
+    room = static_cast<float>(std::sqrt(static_cast<double>(m)) * costmap_.resolution());
+    blocked = m == 0 || room + slack < config_.half_width;
+  } else {
+    for (int j = j0; j < j1; ++j) {
+      for (int i = i0; i < i1; ++i) {
+        if (costmap_.occupied(i, j)) continue;
+        const double d = costmap_.centre_distance(i, j);
+        room = std::max(room, d);
+        if (d + slack >= config_.half_width) blocked = false;
+      }
     }
   }
   const double narrowness = std::max(0.0, 1.0 - room / config_.turning_room);
   r = blocked ? std::numeric_limits<float>::infinity() : static_cast<float>(1.0 + config_.narrow_penalty * narrowness);
   return r;
+}
+
+void ObstacleHeuristic::fill_room_tile(std::int32_t tile) {
+  room_tile_ready_[static_cast<std::size_t>(tile)] = 1;
+  const std::int32_t row = tile / room_tiles_per_row_;  // integer division: the tile's coarse row
+  const std::int32_t first = (tile % room_tiles_per_row_) * kRoomTile;
+  const std::int32_t last = std::min(width_, first + kRoomTile);
+  const int i0 = first * factor_;
+  const int i1 = std::min(costmap_.width(), last * factor_);
+  const int j0 = row * factor_;
+  const int j1 = std::min(costmap_.height(), j0 + factor_);
+  std::array<std::int16_t, DistanceField::kMaxCappedCells> d2;
+  std::int16_t* room = room2_.data() + static_cast<std::size_t>(row) * static_cast<std::size_t>(width_);
+  for (int j = j0; j < j1; ++j) {
+    costmap_.capped_squared_distances(j, i0, i1, room_cap_, d2.data());
+    for (int i = i0; i < i1; ++i) {
+      std::int16_t& r = room[i / factor_];
+      r = std::max(r, d2[static_cast<std::size_t>(i - i0)]);
+    }
+  }
 }
 
 float ObstacleHeuristic::settle(std::int32_t c) {

@@ -138,6 +138,8 @@ class ObstacleHeuristic {
   float estimate(std::int32_t c) const;
   // Per-metre cost of crossing coarse cell `c` (+inf: blocked), from its costmap cells on first use.
   float rate(std::int32_t c);
+  // The rooms (room2_) of the coarse cells of room tile `tile`.
+  void fill_room_tile(std::int32_t tile);
   // Fills the way fields of settled cell `c` (and of the cells ahead of it on its way, first).
   void fill_way(std::int32_t c);
   // Whether the straight line between the centres of cells a and b crosses no blocked cell.
@@ -159,7 +161,15 @@ class ObstacleHeuristic {
   std::vector<float> turning_;
   std::vector<std::int32_t> chain_;  // scratch of fill_way
   int open_reach_{-1};               // [costmap cells] see rate(); -1: not used
-  int toward_x_{0};                  // the coarse cell of `toward`
+  // The rooms from capped distances (see rate()): the cap [costmap cells] (-1: the rooms are
+  // scanned from the distance field instead), and per coarse cell the largest squared distance of
+  // its costmap cells [cells^2, capped], filled per tile of kRoomTile cells of a coarse row.
+  static constexpr int kRoomTile = 16;
+  int room_cap_{-1};
+  int room_tiles_per_row_{0};
+  std::vector<std::int16_t> room2_;
+  std::vector<std::uint8_t> room_tile_ready_;
+  int toward_x_{0};  // the coarse cell of `toward`
   int toward_y_{0};
   using Item = std::pair<float, std::int32_t>;  // (distance + estimate, cell)
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open_;

@@ -123,6 +123,11 @@ class Costmap {
   // call in a row segment computes that segment (see DistanceField).
   double centre_distance(int ix, int iy) const { return distance_.at(ix, iy, occupied_.data()); }
   const DistanceField& distance_field() const { return distance_; }
+  // Squared centre distances [cells^2] of cells x0 .. x1 - 1 of row iy, capped at `cap` cells
+  // (DistanceField::capped_squared).
+  void capped_squared_distances(int iy, int x0, int x1, int cap, std::int16_t* out) const {
+    distance_.capped_squared(iy, x0, x1, cap, out, occupied_.data());
+  }
   // A lower bound [m] of the distance from map point p to the nearest occupied cell (as a closed
   // square); 0 outside the grid or on an occupied cell.
   double clearance_lower_bound(const Vec2& p_M) const;

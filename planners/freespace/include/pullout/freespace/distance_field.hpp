@@ -37,7 +37,7 @@ class DistanceField {
  public:
   static constexpr int kBandShift = 6;
   static constexpr int kBandRows = 1 << kBandShift;  // rows of the first pass filled together
-  static constexpr int kSegmentShift = 8;
+  static constexpr int kSegmentShift = 6;
   static constexpr int kSegmentCells = 1 << kSegmentShift;  // cells of a row of the second pass filled together
 
   DistanceField() = default;
@@ -67,6 +67,22 @@ class DistanceField {
     if (!segments_.ready(segment)) fill(ix, iy, segment, occupied);
     return distance_[index(ix, iy)];
   }
+
+  // The squared distances [cells^2] of cells x0 .. x1 - 1 of row iy (inside the grid,
+  // 0 < x1 - x0 <= kMaxCappedCells) into out[0 .. x1 - x0), capped: exact where the squared
+  // distance is below (cap + 1)^2, at least (cap + 1)^2 where it is not (1 <= cap <= kMaxCap).
+  // Fills the row's band of the first pass if needed, never the second pass: each cell is the
+  // least of dx^2 + g(x + dx)^2 over |dx| <= cap (g: the first pass, taken at most cap + 1), a
+  // brute force whose loops vectorise (16-bit lanes), several times cheaper per cell than the
+  // lower envelope while the cap is a few tens of cells. For callers that need distances only up
+  // to a bound (the obstacle heuristic's room to turn).
+  static constexpr int kMaxCap = 126;  // (cap + 1)^2 + cap^2 fits in int16
+  static constexpr int kMaxCappedCells = 256;
+  static_assert(kSegmentCells <= kMaxCappedCells, "row_segment's brute force takes a whole segment");
+  // The second pass of a segment whose cells all lie at most this many cells from an occupied
+  // one is the same brute force, capped there (exact), instead of the lower envelope.
+  static constexpr int kBruteForceReach = 48;
+  void capped_squared(int iy, int x0, int x1, int cap, std::int16_t* out, const std::uint8_t* occupied) const;
 
   // How much of the two passes ran so far (for tests and benchmarks).
   std::size_t filled_bands() const { return bands_.count_ready(); }
