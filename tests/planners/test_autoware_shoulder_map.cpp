@@ -51,6 +51,15 @@ constexpr double kClosedGap = 0.05;
 
 const std::string kMap = std::string(PULLOUT_SOURCE_DIR) + "/../shared/maps/autoware_road_shoulder/lanelet2_map.osm";
 
+// The polygons of every lanelet of the map that makes a lane (the oracle's lanes).
+std::vector<Polygon> lane_polygons(const LaneletMap& map) {
+  std::vector<Polygon> lanes;
+  for (const Lanelet& ll : map.lanelets()) {
+    if (auto lane = to_lane(ll)) lanes.push_back(lane_polygon(*lane));
+  }
+  return lanes;
+}
+
 struct Verdict {
   bool passed{false};
   std::string why;  // when not passed
@@ -100,15 +109,14 @@ std::string oracle_problem(const PullOutPath& path, const std::vector<Polygon>& 
   return "";
 }
 
-Verdict plan_one(const LaneletMap& map, const std::shared_ptr<const LaneletMap>& shared, const Config& config,
-                 PlannerType planner_type, const ShoulderCase& c, double yaw_offset,
-                 const std::vector<Polygon>& lanes) {
+Verdict plan_one(const std::shared_ptr<const LaneletMap>& map, const Config& config, PlannerType planner_type,
+                 const ShoulderCase& c, double yaw_offset, const std::vector<Polygon>& lanes) {
   StartPlannerParameters params = config.start_planner;
   params.search_priority = {planner_type};
   params.enable_back = false;  // from the current pose, as Autoware's planner tests
   params.freespace_planner.enable_freespace_planner = false;
   params.divide_pull_out_path = true;
-  const StartPlanner planner(config.vehicle, params, config.service.limits, shared);
+  const StartPlanner planner(config.vehicle, params, config.service.limits, map);
   PullOutRequest r;
   r.vehicle_id = "shoulder-map";
   r.request_id = 1;
@@ -144,22 +152,29 @@ Verdict plan_one(const LaneletMap& map, const std::shared_ptr<const LaneletMap>&
   }
   v.why = oracle_problem(result.path, lanes, config.vehicle, params);
   v.passed = v.why.empty();
-  (void)map;
   return v;
 }
 
-TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
-  if (!std::filesystem::exists(kMap)) {
-    GTEST_SKIP() << "skipped: " << kMap << " is absent (the shared Autoware maps beside the checkout)";
+// The map, the shipped configuration and the map's lane polygons, for each test of the map.
+class AutowareShoulderMap : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!std::filesystem::exists(kMap)) {
+      GTEST_SKIP() << "skipped: " << kMap << " is absent (the shared Autoware maps beside the checkout)";
+    }
+    map = load_lanelet_map(kMap);
+    ASSERT_EQ(map->lanelets().size(), 371u);
+    ASSERT_EQ(map->count(LaneletSubtype::kRoadShoulder), 95u);
+    config = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
+    lanes = lane_polygons(*map);
   }
-  const auto map = load_lanelet_map(kMap);
-  ASSERT_EQ(map->lanelets().size(), 371u);
-  ASSERT_EQ(map->count(LaneletSubtype::kRoadShoulder), 95u);
-  const Config config = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
+
+  std::shared_ptr<const LaneletMap> map;
+  Config config;
   std::vector<Polygon> lanes;
-  for (const Lanelet& ll : map->lanelets()) {
-    if (auto lane = to_lane(ll)) lanes.push_back(lane_polygon(*lane));
-  }
+};
+
+TEST_F(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
   const double kTen = 10.0 * kPi / 180.0;
   std::map<PlannerType, std::size_t> passed;
   std::map<PlannerType, std::vector<std::string>> failures;
@@ -198,7 +213,7 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
       any = true;
       ++cases;
       for (PlannerType type : {PlannerType::kShift, PlannerType::kGeometric}) {
-        const Verdict v = plan_one(*map, map, config, type, *c, yaw, lanes);
+        const Verdict v = plan_one(map, config, type, *c, yaw, lanes);
         if (v.passed) {
           ++cases_passed[type];
         } else {
@@ -248,16 +263,7 @@ TEST(AutowareShoulderMap, EveryShoulderPullsOutWithEachPlanner) {
 // passes both its checks and stays in the shoulder and the road (bench/tools/
 // autoware_geometric_oracle.py 520 --yaw -10). Before, all 10 candidates found no S and the
 // shunting gave 12 segments.
-TEST(AutowareShoulderMap, OnABendAwayFromTheShoulderTheTwoArcsEndWhereAutowaresDo) {
-  if (!std::filesystem::exists(kMap)) {
-    GTEST_SKIP() << "skipped: " << kMap << " is absent (the shared Autoware maps beside the checkout)";
-  }
-  const auto map = load_lanelet_map(kMap);
-  const Config config = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
-  std::vector<Polygon> lanes;
-  for (const Lanelet& ll : map->lanelets()) {
-    if (auto lane = to_lane(ll)) lanes.push_back(lane_polygon(*lane));
-  }
+TEST_F(AutowareShoulderMap, OnABendAwayFromTheShoulderTheTwoArcsEndWhereAutowaresDo) {
   const Lanelet* shoulder = nullptr;
   for (const Lanelet& ll : map->lanelets()) {
     if (ll.id == 520) shoulder = &ll;
@@ -265,7 +271,7 @@ TEST(AutowareShoulderMap, OnABendAwayFromTheShoulderTheTwoArcsEndWhereAutowaresD
   ASSERT_NE(shoulder, nullptr);
   const auto c = shoulder_case(*map, *shoulder);
   ASSERT_TRUE(c);
-  const Verdict v = plan_one(*map, map, config, PlannerType::kGeometric, *c, -10.0 * kPi / 180.0, lanes);
+  const Verdict v = plan_one(map, config, PlannerType::kGeometric, *c, -10.0 * kPi / 180.0, lanes);
   EXPECT_TRUE(v.passed) << v.why;
 }
 
@@ -294,10 +300,7 @@ TEST_P(RoadLaneStart, FromTheCenterlineOfEveryRoadLanelet) {
   }
   const auto map = load_lanelet_map(path);
   const Config config = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
-  std::vector<Polygon> lanes;
-  for (const Lanelet& ll : map->lanelets()) {
-    if (auto lane = to_lane(ll)) lanes.push_back(lane_polygon(*lane));
-  }
+  const std::vector<Polygon> lanes = lane_polygons(*map);
   StartPlannerParameters params = config.start_planner;
   params.freespace_planner.enable_freespace_planner = false;
   const StartPlanner planner(config.vehicle, params, config.service.limits, map);
