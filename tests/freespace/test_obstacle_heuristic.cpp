@@ -114,53 +114,85 @@ std::vector<std::pair<int, int>> occupied_cells(const Map& m) {
   return occupied;
 }
 
-// Several turning rooms: where a costmap cell has room to turn, the heuristic tells so from the
-// summed-area table without the distance transform (search_support.cpp, rate()); the oracle scans
-// brute-force distances. Room lengths on, just off and between whole cells.
+// The lazy search on map m, asked at every coarse cell centre in a random order from a root
+// somewhere else, against the oracle's Dijkstra distances on brute-force rates.
+void expect_lazy_search_matches_dijkstra(const Map& m, const fd::ObstacleHeuristicConfig& config, std::mt19937& rng) {
+  const Costmap costmap({}, kRes, m.w, m.h, m.occ);
+  const std::vector<std::pair<int, int>> occupied = occupied_cells(m);
+  const std::vector<float> rate = oracle_rates(m, occupied, config);
+  const int cw = m.w / kFactor, ch = m.h / kFactor;
+  std::uniform_int_distribution<int> cx(0, cw - 1), cy(0, ch - 1);
+  int gx = cx(rng), gy = cy(rng);
+  while (std::isinf(rate[static_cast<std::size_t>(gy) * cw + gx])) {
+    gx = cx(rng);
+    gy = cy(rng);
+  }
+  const std::vector<float> dist = oracle_distances(m, rate, gx, gy);
+  // (At coarse cell centres the bilinear value is the cell's own.)
+  const auto centre = [&](int ci, int cj) {
+    return Pose2{(ci + 0.5) * kFactor * kRes, (cj + 0.5) * kFactor * kRes, 0.0};
+  };
+  fd::ObstacleHeuristic heuristic(costmap, config, centre(gx, gy), centre(cx(rng), cy(rng)));
+  std::vector<int> order(rate.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+  std::shuffle(order.begin(), order.end(), rng);
+  int finite = 0;
+  for (const int c : order) {
+    const double expected = dist[static_cast<std::size_t>(c)];
+    const double got = heuristic.distance(centre(c % cw, c / cw));
+    if (std::isinf(expected) || std::isinf(rate[static_cast<std::size_t>(c)])) {
+      EXPECT_TRUE(std::isinf(got)) << "cell " << c % cw << "," << c / cw;
+      continue;
+    }
+    ++finite;
+    // Float sums over paths of equal length may round differently: a relative 1e-5.
+    ASSERT_NEAR(got, expected, 1e-5 * std::max(1.0, expected)) << "cell " << c % cw << "," << c / cw;
+  }
+  EXPECT_GT(finite, cw * ch / 3);  // the map is mostly connected: the test compares many cells
+}
+
+// Several turning rooms: the heuristic takes the rooms from distances capped a cell beyond the
+// turning room (search_support.cpp, rate()); the oracle scans brute-force distances. Room lengths
+// on, just off and between whole cells.
 TEST(ObstacleHeuristic, LazySearchTowardsTheRootGivesDijkstraDistances) {
   std::mt19937 rng(13);
   constexpr double kTurningRooms[] = {1.5, 0.95, 2.25, 1.0 + 1e-9, 0.7};
   for (int trial = 0; trial < 6; ++trial) {
     const Map m = random_map(rng);
-    const Costmap costmap({}, kRes, m.w, m.h, m.occ);
-    const std::vector<std::pair<int, int>> occupied = occupied_cells(m);
     fd::ObstacleHeuristicConfig config;
     config.half_width = 0.6;
     config.cell_size = kRes * kFactor;
     config.turning_room = trial < 2 ? 1.5 : kTurningRooms[trial - 1];
     config.narrow_penalty = 3.0;
-    const std::vector<float> rate = oracle_rates(m, occupied, config);
-    const int cw = m.w / kFactor, ch = m.h / kFactor;
-    std::uniform_int_distribution<int> cx(0, cw - 1), cy(0, ch - 1);
-    int gx = cx(rng), gy = cy(rng);
-    while (std::isinf(rate[static_cast<std::size_t>(gy) * cw + gx])) {
-      gx = cx(rng);
-      gy = cy(rng);
-    }
-    const std::vector<float> dist = oracle_distances(m, rate, gx, gy);
-    // The lazy search, asked at coarse cell centres (there its bilinear value is the cell's own)
-    // in a random order, from a root somewhere else.
-    const auto centre = [&](int ci, int cj) {
-      return Pose2{(ci + 0.5) * kFactor * kRes, (cj + 0.5) * kFactor * kRes, 0.0};
-    };
-    fd::ObstacleHeuristic heuristic(costmap, config, centre(gx, gy), centre(cx(rng), cy(rng)));
-    std::vector<int> order(rate.size());
-    for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
-    std::shuffle(order.begin(), order.end(), rng);
-    int finite = 0;
-    for (const int c : order) {
-      const double expected = dist[static_cast<std::size_t>(c)];
-      const double got = heuristic.distance(centre(c % cw, c / cw));
-      if (std::isinf(expected) || std::isinf(rate[static_cast<std::size_t>(c)])) {
-        EXPECT_TRUE(std::isinf(got)) << "cell " << c % cw << "," << c / cw;
-        continue;
-      }
-      ++finite;
-      // Float sums over paths of equal length may round differently: a relative 1e-5.
-      ASSERT_NEAR(got, expected, 1e-5 * std::max(1.0, expected)) << "cell " << c % cw << "," << c / cw;
-    }
-    EXPECT_GT(finite, cw * ch / 3);  // the map is mostly connected: the test compares many cells
+    expect_lazy_search_matches_dijkstra(m, config, rng);
   }
+}
+
+// A turning room too long for the capped distances' 16 bits (13 m = 130 cells): the rooms are
+// scanned from the distance field, and the summed-area table tells the cells with room to turn
+// (no occupied cell within 131 cells: the middle of a 40 m x 30 m yard with small boxes in its
+// corners).
+TEST(ObstacleHeuristic, ALongTurningRoomGivesTheSameDistances) {
+  std::mt19937 rng(5);
+  Map m{400, 300, std::vector<std::uint8_t>(400 * 300, 0)};
+  std::uniform_int_distribution<int> corner(0, 40), side(2, 6);
+  for (int k = 0; k < 8; ++k) {
+    const int x0 = k % 2 == 0 ? corner(rng) : m.w - 7 - corner(rng);
+    const int y0 = k % 4 < 2 ? corner(rng) : m.h - 7 - corner(rng);
+    const int sx = side(rng), sy = side(rng);
+    for (int j = y0; j < std::min(m.h, y0 + sy); ++j) {
+      for (int i = x0; i < std::min(m.w, x0 + sx); ++i) m.occ[static_cast<std::size_t>(j) * m.w + i] = 1;
+    }
+  }
+  fd::ObstacleHeuristicConfig config;
+  config.half_width = 0.6;
+  config.cell_size = kRes * kFactor;
+  config.turning_room = 13.0;
+  config.narrow_penalty = 3.0;
+  expect_lazy_search_matches_dijkstra(m, config, rng);
+  // Some cells had room to turn (rate 1): the shortcut's case was compared too.
+  const std::vector<float> rate = oracle_rates(m, occupied_cells(m), config);
+  EXPECT_GT(std::count(rate.begin(), rate.end(), 1.0F), 50);
 }
 
 // The hybrid A* asks first at its root and then around it, where the lazy search has settled the

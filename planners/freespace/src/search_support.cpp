@@ -218,30 +218,12 @@ float ObstacleHeuristic::rate(std::int32_t c) {
   const int j0 = (c / width_) * factor_;
   const int i1 = std::min(costmap_.width(), i0 + factor_);
   const int j1 = std::min(costmap_.height(), j0 + factor_);
-  // Most of an open lot's cells have room to turn: then the rate is 1 whatever the exact room,
-  // and the summed-area table tells so without the distance transform (filling it for the
-  // heuristic's reach cost more than the rest of a long search). A costmap cell whose box of
-  // open_reach_ cells each way holds no occupied cell (the border counts as one) has its nearest
-  // occupied cell centre more than open_reach_ cells away, so its room is at least
-  // turning_room (see the constructor) and it is not blocked either (half_width < turning_room):
-  // the same rate as the scan below gives. The centre and the four corners are tried.
-  if (open_reach_ >= 0) {
-    const int xs[5] = {(i0 + i1 - 1) / 2, i0, i1 - 1, i0, i1 - 1};
-    const int ys[5] = {(j0 + j1 - 1) / 2, j0, j0, j1 - 1, j1 - 1};
-    for (int k = 0; k < 5; ++k) {
-      if (costmap_.occupied_in_box(xs[k] - open_reach_, ys[k] - open_reach_, xs[k] + open_reach_,
-                                   ys[k] + open_reach_) == 0) {
-        r = 1.0F;
-        return r;
-      }
-    }
-  }
   bool blocked = true;
   double room = 0.0;
   if (room_cap_ >= 0) {
-    // The same room and verdict as the scan below: the largest squared distance of the cell's
-    // costmap cells, rounded as the distance field rounds each (a monotone rounding: the largest
-    // rounded is the rounded largest). It is exact up to the cap, and beyond it the rate is 1
+    // The largest squared distance of the cell's costmap cells, rounded as the distance field
+    // rounds each (a monotone rounding: the largest rounded is the rounded largest): the same
+    // room and verdict as the scan below. It is exact up to the cap, and beyond it the rate is 1
     // and the cell not blocked either way. A free costmap cell lies at least a cell from an
     // occupied one: 0 means that all of them are occupied (blocked, as the scan finds).
     const std::int32_t tile = (c / width_) * room_tiles_per_row_ + (c % width_) / kRoomTile;
@@ -250,6 +232,23 @@ float ObstacleHeuristic::rate(std::int32_t c) {
     room = static_cast<float>(std::sqrt(static_cast<double>(m)) * costmap_.resolution());
     blocked = m == 0 || room + slack < config_.half_width;
   } else {
+    // (A cap too large for the brute force's 16 bits: a turning room of hundreds of cells.) Where
+    // a costmap cell's box of open_reach_ cells each way holds no occupied cell (the border counts
+    // as one), its nearest occupied cell centre lies more than open_reach_ cells away, so its room
+    // is at least turning_room (see the constructor) and it is not blocked either (half_width <
+    // turning_room): rate 1 without the distance transform. The centre and the four corners are
+    // tried, then the cells' distances scanned.
+    if (open_reach_ >= 0) {
+      const int xs[5] = {(i0 + i1 - 1) / 2, i0, i1 - 1, i0, i1 - 1};
+      const int ys[5] = {(j0 + j1 - 1) / 2, j0, j0, j1 - 1, j1 - 1};
+      for (int k = 0; k < 5; ++k) {
+        if (costmap_.occupied_in_box(xs[k] - open_reach_, ys[k] - open_reach_, xs[k] + open_reach_,
+                                     ys[k] + open_reach_) == 0) {
+          r = 1.0F;
+          return r;
+        }
+      }
+    }
     for (int j = j0; j < j1; ++j) {
       for (int i = i0; i < i1; ++i) {
         if (costmap_.occupied(i, j)) continue;
@@ -277,9 +276,12 @@ void ObstacleHeuristic::fill_room_tile(std::int32_t tile) {
   std::int16_t* room = room2_.data() + static_cast<std::size_t>(row) * static_cast<std::size_t>(width_);
   for (int j = j0; j < j1; ++j) {
     costmap_.capped_squared_distances(j, i0, i1, room_cap_, d2.data());
-    for (int i = i0; i < i1; ++i) {
-      std::int16_t& r = room[i / factor_];
-      r = std::max(r, d2[static_cast<std::size_t>(i - i0)]);
+    const std::int16_t* d = d2.data();
+    for (std::int32_t x = first; x < last; ++x) {
+      const int cells = std::min(factor_, i1 - x * factor_);  // (the grid's last coarse column may be partial)
+      std::int16_t& r = room[x];
+      for (int k = 0; k < cells; ++k) r = std::max(r, d[k]);
+      d += cells;
     }
   }
 }
