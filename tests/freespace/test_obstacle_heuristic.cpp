@@ -115,11 +115,10 @@ std::vector<std::pair<int, int>> occupied_cells(const Map& m) {
 }
 
 // The lazy search on map m, asked at every coarse cell centre in a random order from a root
-// somewhere else, against the oracle's Dijkstra distances on brute-force rates.
-void expect_lazy_search_matches_dijkstra(const Map& m, const fd::ObstacleHeuristicConfig& config, std::mt19937& rng) {
+// somewhere else, against the oracle's Dijkstra distances on `rate` (oracle_rates of m).
+void expect_lazy_search_matches_dijkstra(const Map& m, const fd::ObstacleHeuristicConfig& config,
+                                         const std::vector<float>& rate, std::mt19937& rng) {
   const Costmap costmap({}, kRes, m.w, m.h, m.occ);
-  const std::vector<std::pair<int, int>> occupied = occupied_cells(m);
-  const std::vector<float> rate = oracle_rates(m, occupied, config);
   const int cw = m.w / kFactor, ch = m.h / kFactor;
   std::uniform_int_distribution<int> cx(0, cw - 1), cy(0, ch - 1);
   int gx = cx(rng), gy = cy(rng);
@@ -164,7 +163,7 @@ TEST(ObstacleHeuristic, LazySearchTowardsTheRootGivesDijkstraDistances) {
     config.cell_size = kRes * kFactor;
     config.turning_room = trial < 2 ? 1.5 : kTurningRooms[trial - 1];
     config.narrow_penalty = 3.0;
-    expect_lazy_search_matches_dijkstra(m, config, rng);
+    expect_lazy_search_matches_dijkstra(m, config, oracle_rates(m, occupied_cells(m), config), rng);
   }
 }
 
@@ -189,9 +188,9 @@ TEST(ObstacleHeuristic, ALongTurningRoomGivesTheSameDistances) {
   config.cell_size = kRes * kFactor;
   config.turning_room = 13.0;
   config.narrow_penalty = 3.0;
-  expect_lazy_search_matches_dijkstra(m, config, rng);
-  // Some cells had room to turn (rate 1): the shortcut's case was compared too.
   const std::vector<float> rate = oracle_rates(m, occupied_cells(m), config);
+  expect_lazy_search_matches_dijkstra(m, config, rate, rng);
+  // Some cells had room to turn (rate 1): the shortcut's case was compared too.
   EXPECT_GT(std::count(rate.begin(), rate.end(), 1.0F), 50);
 }
 

@@ -8,10 +8,20 @@
 #include <optional>
 #include <vector>
 
+#include "path_oracles.hpp"
 #include "pullout/lanes/lane_world.hpp"
 #include "pullout/maps/lanelet_map.hpp"
 
 namespace pullout {
+
+// Every road and shoulder lanelet polygon of the map: where a path may go (the oracles' lanes).
+inline std::vector<Polygon> drivable_polygons(const LaneletMap& map) {
+  std::vector<Polygon> out;
+  for (const Lanelet& ll : map.lanelets()) {
+    if (auto lane = to_lane(ll)) out.push_back(oracle::lane_polygon(*lane));
+  }
+  return out;
+}
 
 // The road lanelet `from` and its road successors (turn_direction=straight first), about
 // `length_m` of road in all.

@@ -51,15 +51,6 @@ constexpr double kClosedGap = 0.05;
 
 const std::string kMap = std::string(PULLOUT_SOURCE_DIR) + "/../shared/maps/autoware_road_shoulder/lanelet2_map.osm";
 
-// The polygons of every lanelet of the map that makes a lane (the oracle's lanes).
-std::vector<Polygon> lane_polygons(const LaneletMap& map) {
-  std::vector<Polygon> lanes;
-  for (const Lanelet& ll : map.lanelets()) {
-    if (auto lane = to_lane(ll)) lanes.push_back(lane_polygon(*lane));
-  }
-  return lanes;
-}
-
 struct Verdict {
   bool passed{false};
   std::string why;  // when not passed
@@ -166,7 +157,7 @@ class AutowareShoulderMap : public ::testing::Test {
     ASSERT_EQ(map->lanelets().size(), 371u);
     ASSERT_EQ(map->count(LaneletSubtype::kRoadShoulder), 95u);
     config = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
-    lanes = lane_polygons(*map);
+    lanes = drivable_polygons(*map);
   }
 
   std::shared_ptr<const LaneletMap> map;
@@ -300,7 +291,7 @@ TEST_P(RoadLaneStart, FromTheCenterlineOfEveryRoadLanelet) {
   }
   const auto map = load_lanelet_map(path);
   const Config config = load_config(std::string(PULLOUT_SOURCE_DIR) + "/config/pullout.yaml");
-  const std::vector<Polygon> lanes = lane_polygons(*map);
+  const std::vector<Polygon> lanes = drivable_polygons(*map);
   StartPlannerParameters params = config.start_planner;
   params.freespace_planner.enable_freespace_planner = false;
   const StartPlanner planner(config.vehicle, params, config.service.limits, map);

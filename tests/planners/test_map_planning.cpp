@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "map_cases.hpp"
 #include "path_oracles.hpp"
 #include "pullout/collision/footprint.hpp"
 #include "pullout/config/config.hpp"
@@ -53,15 +54,6 @@ std::string dump(const std::vector<PlannerAttempt>& table) {
   for (const auto& a : table) {
     out += "  planner " + std::to_string(static_cast<int>(a.planner)) + " margin " + std::to_string(a.margin_m) +
            " back " + std::to_string(a.backward_distance_m) + ": " + describe(a) + "\n";
-  }
-  return out;
-}
-
-// Every road and shoulder lanelet polygon of the map: where a path may go.
-std::vector<Polygon> drivable_polygons(const LaneletMap& map) {
-  std::vector<Polygon> out;
-  for (const Lanelet& ll : map.lanelets()) {
-    if (auto lane = to_lane(ll)) out.push_back(lane_polygon(*lane));
   }
   return out;
 }
