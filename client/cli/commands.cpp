@@ -108,6 +108,19 @@ void note_fleet_not_used(const Scenario& scenario, const char* what, std::ostrea
       << ": only its own vehicle is, without the other vehicles' paths in the safety check\n";
 }
 
+// Only search_priority and search_policy travel with a request; the service plans with its own
+// parameters otherwise (a vehicle does not set another's margins). Named, not dropped silently.
+void note_planner_keys_not_sent(const Scenario& scenario, std::ostream& err) {
+  if (scenario.local_planner_keys.empty()) return;
+  err << "pullout: note: the scenario's planner key" << (scenario.local_planner_keys.size() == 1 ? " " : "s ");
+  for (std::size_t i = 0; i < scenario.local_planner_keys.size(); ++i) {
+    err << (i == 0 ? "" : ", ") << scenario.local_planner_keys[i];
+  }
+  err << (scenario.local_planner_keys.size() == 1 ? " is" : " are")
+      << " not sent: the service plans with its own parameters (a request carries only search_priority and "
+         "search_policy; `pullout plan` applies them all)\n";
+}
+
 }  // namespace
 
 int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
@@ -159,6 +172,7 @@ int run_request(const RequestOptions& options, std::ostream& out, std::ostream& 
     return kExitBadInput;
   }
   note_fleet_not_used(scenario, "sent", err);
+  note_planner_keys_not_sent(scenario, err);
   const auto deadline = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
                                                  std::chrono::duration<double>(options.timeout_s));
 

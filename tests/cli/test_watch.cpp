@@ -123,5 +123,34 @@ TEST_F(Watch, OnceWithoutAServiceSaysSoAndFails) {
   EXPECT_NE(read_file_tail(out_file, 4000).find("(no vehicles)"), std::string::npos);
 }
 
+// `pullout request` sends a scenario's search_priority and search_policy only: the service plans
+// with its own parameters. The other `planner:` keys are named on stderr before it looks for a
+// service (none here: it then fails as it must), not dropped without a word.
+TEST(RequestCli, NamesThePlannerKeysItDoesNotSend) {
+  DomainLease lease;
+  TempDir temp;
+  const auto stderr_of = [&](const std::string& scenario) {
+    const std::string err_file = temp.path() + "/" + scenario + ".err";
+    ChildProcess request({PULLOUT_CLI_EXE, "request", source_path("tests/scenarios/" + scenario + ".yaml"), "--domain",
+                          std::to_string(lease.domain()), "--profiles", loopback_profiles_path(), "--timeout", "0.5"},
+                         temp.path() + "/" + scenario + ".out", err_file);
+    const auto exit = request.wait_exit(15s);
+    EXPECT_TRUE(exit && exit->exited && exit->exit_code == 3) << scenario;
+    return read_file_tail(err_file, 4000);
+  };
+  const std::string lot = stderr_of("freespace_parking_lot");
+  EXPECT_NE(lot.find("the scenario's planner key freespace_planner.vehicle_shape_margin is not sent"),
+            std::string::npos)
+      << lot;
+  EXPECT_NE(lot.find("no pullout service found"), std::string::npos) << lot;
+  const std::string blocked = stderr_of("freespace_blocked_ahead");
+  EXPECT_NE(blocked.find("planner keys maximum_lateral_acc, minimum_lateral_acc, "
+                         "freespace_planner.vehicle_shape_margin are not sent"),
+            std::string::npos)
+      << blocked;
+  const std::string carried = stderr_of("clothoid_only");  // search_priority only: all of it is sent
+  EXPECT_EQ(carried.find("not sent"), std::string::npos) << carried;
+}
+
 }  // namespace
 }  // namespace pullout::integration

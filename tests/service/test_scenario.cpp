@@ -155,6 +155,25 @@ TEST(Scenario, AllFieldsAndOverrides) {
   EXPECT_EQ(s.expect.margin_m, 0.5);
 }
 
+// A request carries only search_priority and search_policy; every other `planner:` key is named
+// (dotted, in file order) so that `pullout request` can say the service will not use it.
+TEST(Scenario, PlannerKeysARequestDoesNotCarryAreListed) {
+  ScenarioFile file(std::string(kLanes) +
+                    "start: {x: 10.0, y: 3.5, yaw: 0.0}\ngoal: {x: 90.0, y: 0.0, yaw: 0.0}\n"
+                    "planner:\n  lateral_jerk: 0.7\n  search_priority: [SHIFT]\n"
+                    "  freespace_planner: {vehicle_shape_margin: 0.4, astar: {distance_heuristic_weight: 1.5}}\n"
+                    "  search_policy: distance_priority\n");
+  const Scenario s = load_scenario(file.path());
+  EXPECT_EQ(s.local_planner_keys, (std::vector<std::string>{"lateral_jerk", "freespace_planner.vehicle_shape_margin",
+                                                            "freespace_planner.astar.distance_heuristic_weight"}));
+  EXPECT_EQ(s.request.overrides.search_priority, std::vector<PlannerType>{PlannerType::kShift});
+
+  ScenarioFile carried(std::string(kLanes) +
+                       "start: {x: 10.0, y: 3.5, yaw: 0.0}\ngoal: {x: 90.0, y: 0.0, yaw: 0.0}\n"
+                       "planner: {search_priority: [SHIFT], search_policy: distance_priority}\n");
+  EXPECT_TRUE(load_scenario(carried.path()).local_planner_keys.empty());
+}
+
 TEST(Scenario, VehicleIdDefaultsToTheFileName) {
   ScenarioFile file(std::string(kLanes) + kPoses);
   const Scenario s = load_scenario(file.path());

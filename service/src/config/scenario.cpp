@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <utility>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -246,6 +247,20 @@ void set_overrides(const YAML::Node& planner, const StartPlannerParameters& para
   if (planner["search_policy"].IsDefined()) out.search_policy = params.search_policy;
 }
 
+// The dotted keys under `planner:` (at `prefix`) that set_overrides does not carry, in file order.
+void collect_local_keys(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& out) {
+  for (const auto& entry : node) {
+    const std::string name = entry.first.as<std::string>("?");
+    if (prefix.empty() && (name == "search_priority" || name == "search_policy")) continue;
+    const std::string key = prefix.empty() ? name : prefix + "." + name;
+    if (entry.second.IsMap()) {
+      collect_local_keys(entry.second, key, out);
+    } else {
+      out.push_back(key);
+    }
+  }
+}
+
 // `vehicle:` (at `key`): either `{profile: NAME}` (a profile of the config the request is planned
 // with: the request names it, and the service resolves it) or dimension keys over the base
 // config's vehicle (the request carries them all). `vehicle` gets what the CLI draws.
@@ -383,6 +398,7 @@ Scenario load_scenario(const std::string& path, const Config& base) {
     apply_start_planner_parameters(planner, "planner", s.parameters, problems);
     append_parameter_issues(validate_parameters(s.parameters), "planner", problems);  // between keys
     set_overrides(planner, s.parameters, request.overrides);
+    if (planner.IsMap()) collect_local_keys(planner, "", s.local_planner_keys);
   }
   if (root.read("deadline_ms", request.deadline_ms) && request.deadline_ms < 0.0) {
     problems.push_back("deadline_ms: must be >= 0 (0 = the default)");

@@ -77,6 +77,10 @@ struct Scenario {
   std::shared_ptr<const LaneletMap> map;  // loaded from map_path (null without)
   VehicleInfo vehicle;                    // base config's vehicle with the scenario's overrides
   StartPlannerParameters parameters;      // base config's parameters with `planner:` applied
+  // The `planner:` keys a request does not carry (all but search_priority and search_policy),
+  // dotted ("freespace_planner.vehicle_shape_margin"): `pullout plan` applies them, a running
+  // service plans with its own parameters (`pullout request` names them).
+  std::vector<std::string> local_planner_keys;
   ScenarioExpectation expect;
   // `fleet:`: the other vehicles' requests (this scenario's lanes and objects, their own id, start,
   // goal and vehicle), executing their paths in this order before `request` is planned.
