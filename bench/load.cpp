@@ -223,13 +223,12 @@ int run_worker(const WorkerArgs& a) {
       std::fprintf(stderr, "worker %d: %s did not match the service\n", a.first, client->vehicle_id().c_str());
       return 3;
     }
-    while (client->matched_services() < static_cast<std::size_t>(a.services)) {
+    while (!client->wait_for_services(static_cast<std::size_t>(a.services), 100ms)) {
       if (g_stop.load() || SteadyClock::now() >= setup_deadline) {
         std::fprintf(stderr, "worker %d: %s matched %zu of %d services\n", a.first, client->vehicle_id().c_str(),
                      client->matched_services(), a.services);
         return 3;
       }
-      std::this_thread::sleep_for(10ms);
     }
   }
   note("clients matched");

@@ -337,7 +337,7 @@ class __attribute__((visibility("hidden"))) Client::Impl final : public client_d
   std::optional<PullOutStatus> latest_status() const;
   std::uint64_t current_request_id() const;
   std::optional<std::uint32_t> current_segment() const;
-  bool wait_for_service(Duration timeout) const;
+  bool wait_for_services(std::size_t count, Duration timeout) const;
   ServiceState service_state() const;
   std::size_t matched_services() const;
 
@@ -1130,6 +1130,7 @@ SteadyClock::time_point Client::Impl::update_service_and_resend() {
     // A new reader of requests (a service that came back, or a second one): the volatile topic
     // gives it nothing that was written before, so the pending request goes again now.
     const bool new_reader = m.request > request_matches_ || matched_new_reader;
+    changed = m.request != request_matches_;  // wait_for_services counts them
     request_matches_ = m.request;
     if (connected && service_state_ != ServiceState::kConnected) {
       service_state_ = ServiceState::kConnected;
@@ -1457,13 +1458,15 @@ std::optional<std::uint32_t> Client::Impl::current_segment() const {
   return std::nullopt;
 }
 
-bool Client::Impl::wait_for_service(Duration timeout) const {
+bool Client::Impl::wait_for_services(std::size_t count, Duration timeout) const {
   // The client's thread tracks the matched counts (update_service_and_resend) and notifies.
   const auto deadline = deadline_after(timeout);
   std::unique_lock<std::mutex> lock(state_mutex_);
-  return state_cv_.wait_until(lock, deadline, [&] {
-    return stop_.load() || service_state_ == ServiceState::kConnected;
-  }) && service_state_ == ServiceState::kConnected;
+  const auto ready = [&] {
+    return service_state_ == ServiceState::kConnected &&
+           static_cast<std::size_t>(std::max(request_matches_, 0)) >= count;
+  };
+  return state_cv_.wait_until(lock, deadline, [&] { return stop_.load() || ready(); }) && ready();
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -1489,7 +1492,10 @@ std::optional<PullOutPath> Client::latest_path() const { return impl_->latest_pa
 std::optional<PullOutStatus> Client::latest_status() const { return impl_->latest_status(); }
 std::uint64_t Client::current_request_id() const { return impl_->current_request_id(); }
 std::optional<std::uint32_t> Client::current_segment() const { return impl_->current_segment(); }
-bool Client::wait_for_service(Duration timeout) const { return impl_->wait_for_service(timeout); }
+bool Client::wait_for_service(Duration timeout) const { return impl_->wait_for_services(1, timeout); }
+bool Client::wait_for_services(std::size_t count, Duration timeout) const {
+  return impl_->wait_for_services(count, timeout);
+}
 ServiceState Client::service_state() const { return impl_->service_state(); }
 std::size_t Client::matched_services() const { return impl_->matched_services(); }
 const std::string& Client::vehicle_id() const { return impl_->options().vehicle_id; }

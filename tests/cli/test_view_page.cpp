@@ -131,11 +131,7 @@ TEST_F(ViewPage, DrawsTheVehicleAndFollowsItThroughItsSegments) {
   // matched this client's request writer never reaches it, and is not sent again once answered
   // (the page then showed the path with no lanes, objects or footprint in a CI run). Both the
   // service and the view read it before the vehicle asks.
-  const auto matched_deadline = std::chrono::steady_clock::now() + 10s;
-  while (client->matched_services() < 2 && std::chrono::steady_clock::now() < matched_deadline) {
-    std::this_thread::sleep_for(20ms);
-  }
-  ASSERT_GE(client->matched_services(), 2u) << "the view's request reader never matched the vehicle's writer";
+  ASSERT_TRUE(client->wait_for_services(2, 10s)) << "the view's request reader never matched the vehicle's writer";
   const Scenario scenario = load_test_scenario("parallel_spot_reverse");
   const std::uint64_t id = client->send(scenario.request);
   const auto path = client->wait_for_path(id, kReplyTimeout);

@@ -741,6 +741,19 @@ TEST(ClientOptionsTest, InvalidResendOptionsThrow) {
   EXPECT_THROW(Client{o}, std::invalid_argument);
 }
 
+// A vehicle with replicas of the service waits until each reads its requests (a request sent
+// before a replica matched never reaches it): one service is not two.
+TEST(ClientTest, WaitsForAsManyServicesAsAsked) {
+  Client client(options("car-9"));
+  FakeService first;
+  ASSERT_TRUE(client.wait_for_services(1, 10s));
+  EXPECT_EQ(client.matched_services(), 1u);
+  EXPECT_FALSE(client.wait_for_services(2, 300ms));
+  FakeService second;
+  ASSERT_TRUE(client.wait_for_services(2, 10s));
+  EXPECT_EQ(client.matched_services(), 2u);
+}
+
 TEST(ClientTest, NoServiceMeansNoMatch) {
   ClientOptions o = options("car-8");
   o.domain_id = 231;  // no test ever runs a (fake) service there

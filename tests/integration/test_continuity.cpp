@@ -264,10 +264,7 @@ TEST_P(Replicas, TheServingReplicaKilledMidManoeuvreIsReplacedWithTheSamePathAnd
   // replicas started after the first request see this one: it gives them the lanes and objects.
   // A replica that has not matched the vehicle's request writer would never see this request
   // (volatile topic) and could not take the vehicle over with its world.
-  const auto match_deadline = SteadyClock::now() + kMatchTimeout;
-  while (client->matched_services() < static_cast<std::size_t>(replicas) && SteadyClock::now() < match_deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  ASSERT_TRUE(client->wait_for_services(static_cast<std::size_t>(replicas), kMatchTimeout));
   ASSERT_EQ(client->matched_services(), static_cast<std::size_t>(replicas));
   PullOutRequest again_request = scenario.request;
   again_request.ego_pose = path->partial_paths[0].points.back().pose;

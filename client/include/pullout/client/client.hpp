@@ -287,6 +287,10 @@ class PULLOUT_CLIENT_EXPORT Client {
   // usually takes tens of milliseconds but can take a few seconds (lost announcements are repeated
   // periodically): allow several seconds.
   bool wait_for_service(Duration timeout) const;
+  // As wait_for_service, and until at least `count` services (replicas) read this client's
+  // requests (matched_services() >= count): a request sent before a replica has matched never
+  // reaches it. Returns whether both hold. count 0 or 1 is wait_for_service.
+  bool wait_for_services(std::size_t count, Duration timeout) const;
   // How many services (each replica counts) read this client's requests now: the request
   // writer's matched readers. A request sent while a replica is not among them never reaches
   // that replica (the request topic is volatile).
