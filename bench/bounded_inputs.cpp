@@ -7,7 +7,8 @@
 //
 // Cases: 2-point lanes (a road and its shoulder) 20 km, 1e7 m and 1e8 m long; 64 such lanes of
 // 1e7 m; a Lanelet2 map whose road and shoulder are single lanelets 100 km and 1,000 km long
-// (written to a temporary file, loaded as the service loads it, then one route request).
+// (written to a temporary file, loaded as the service loads it, then one route request); 512
+// objects of 64 points each, non-convex (combs).
 #include <sys/resource.h>
 #include <sys/time.h>
 #include <sys/wait.h>
@@ -102,6 +103,26 @@ void run_case(const std::string& name, double deadline_ms) {
     request = shoulder_request(100.0, 2);
     request.lanes.clear();
     request.route_lanelet_ids = {100};
+  } else if (name == "objects512_comb64") {
+    // The most objects a request may carry, each the most points a polygon may have, as a comb
+    // (simple, non-convex: 31 teeth) lining the far edge of the road, 2.5 m from its centreline,
+    // within the collision checks' reach of the paths: every one cut into convex pieces.
+    request = shoulder_request(100.0, 2);
+    for (int k = 0; k < 512; ++k) {
+      pullout::Object o;
+      o.id = k + 1;
+      o.object_class = pullout::ObjectClass::kUnknown;
+      o.pose = {5.0 + 0.17 * k, -2.5, 0.0};
+      o.length_m = 1.0;
+      o.width_m = 1.0;
+      for (int t = 0; t < 31; ++t) {  // the teeth along x, 0.1 m wide, 1 m deep
+        o.polygon.push_back({0.1 * t, 0.0});
+        o.polygon.push_back({0.1 * t + 0.05, (t % 2 == 0) ? -1.0 : -0.5});
+      }
+      o.polygon.push_back({3.1, 0.5});
+      o.polygon.push_back({0.0, 0.5});
+      request.objects.push_back(o);
+    }
   } else {
     const double length = name == "lane_20km" ? 2e4 : name == "lane_1e8m" ? 1e8 : 1e7;
     request = shoulder_request(length, name == "lanes64_1e7m" ? 64 : 2);
@@ -118,7 +139,8 @@ void run_case(const std::string& name, double deadline_ms) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> cases = {"lane_20km", "lane_1e7m", "lane_1e8m", "lanes64_1e7m", "map_100km", "map_1000km"};
+  std::vector<std::string> cases = {"lane_20km", "lane_1e7m",  "lane_1e8m",        "lanes64_1e7m",
+                                    "map_100km", "map_1000km", "objects512_comb64"};
   double deadline_ms = 0.0;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (std::strcmp(argv[i], "--case") == 0) cases = {argv[i + 1]};

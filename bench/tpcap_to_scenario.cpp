@@ -1,7 +1,10 @@
 // A TPCAP case (bench/tpcap.hpp) as a scenario file for `pullout plan` and the tests: a pure
 // freespace problem (a grid, no lanes) in the case's re-centred frame (the start's rear axle at
 // the origin: cases 13-15 lie ~5e9 m out), the map the organisers' demo draws (start and goal box
-// +-15 m), every obstacle polygon as it is, the organisers' vehicle, no shape margin, full steer.
+// +-15 m) as an empty grid, every obstacle polygon as it is as a static object (objects are
+// checked against their true polygons, as bench_freespace --tpcap does; a grid's own obstacles
+// are cells, which close case 7's slot), the organisers' vehicle, no shape margin, full steer,
+// and a deadline as long as the search's budget.
 //
 //   build/bench/tpcap_to_scenario ../shared/benchmarks/tpcap/Case1.csv case1.yaml [--resolution 0.1]
 //
@@ -55,9 +58,11 @@ int main(int argc, char** argv) {
       << ", front_overhang: " << kTpcapFront - kTpcapWheelbase << ", rear_overhang: " << kTpcapRear
       << ", left_overhang: 0.0, right_overhang: 0.0, max_steer_angle: " << kTpcapMaxSteer << "}\n";
   out << "grid:\n  resolution: " << resolution << "\n  origin: {x: " << x0 << ", y: " << y0
-      << ", yaw_deg: 0.0}\n  size: [" << w << ", " << h << "]\n  obstacles:\n";
-  for (const auto& poly : c.obstacles) {
-    out << "    - {polygon: [";
+      << ", yaw_deg: 0.0}\n  size: [" << w << ", " << h << "]\n";
+  out << "objects:  # the obstacles, at rest, their polygons in the map frame\n";
+  for (std::size_t k = 0; k < c.obstacles.size(); ++k) {
+    const auto& poly = c.obstacles[k];
+    out << "  - {id: " << k + 1 << ", class: unknown, x: 0.0, y: 0.0, yaw: 0.0, velocity: 0.0, polygon: [";
     for (std::size_t i = 0; i < poly.size(); ++i)
       out << (i ? ", " : "") << "[" << poly[i].x() << ", " << poly[i].y() << "]";
     out << "]}\n";
@@ -65,8 +70,10 @@ int main(int argc, char** argv) {
   out << "start: {x: " << c.start.x << ", y: " << c.start.y << ", yaw_deg: " << c.start.yaw * pullout::kRadToDeg
       << "}\n";
   out << "goal: {x: " << c.goal.x << ", y: " << c.goal.y << ", yaw_deg: " << c.goal.yaw * pullout::kRadToDeg << "}\n";
+  // The budget of bench_freespace --tpcap; the request's deadline (the most a request may ask
+  // for) would otherwise cut it to the service's default.
   out << "planner:\n  freespace_planner:\n    vehicle_shape_margin: 0.0\n    max_turning_ratio: 1.0\n"
          "    time_limit: 10000.0\n    costmap_configs: {resolution: "
-      << resolution << "}\n";
+      << resolution << "}\ndeadline_ms: 10000\n";
   return out ? 0 : 1;
 }

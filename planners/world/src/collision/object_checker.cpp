@@ -5,7 +5,11 @@
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
 
 namespace pullout {
 
@@ -39,6 +43,87 @@ Polygon convex_hull(Polygon pts) {
   return hull;
 }
 
+double signed_area(const Polygon& pts) {
+  double a = 0.0;
+  for (std::size_t i = 0, j = pts.size() - 1; i < pts.size(); j = i++) {
+    a += pts[j].x() * pts[i].y() - pts[i].x() * pts[j].y();
+  }
+  return 0.5 * a;
+}
+
+// Whether segments ab and cd share a point.
+bool segments_meet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  const double d1 = cross(c, d, a);
+  const double d2 = cross(c, d, b);
+  const double d3 = cross(a, b, c);
+  const double d4 = cross(a, b, d);
+  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
+  const auto on = [](const Vec2& p, const Vec2& q, const Vec2& r) {  // r on segment pq, given collinear
+    return std::min(p.x(), q.x()) <= r.x() && r.x() <= std::max(p.x(), q.x()) && std::min(p.y(), q.y()) <= r.y() &&
+           r.y() <= std::max(p.y(), q.y());
+  };
+  return (d1 == 0 && on(c, d, a)) || (d2 == 0 && on(c, d, b)) || (d3 == 0 && on(a, b, c)) || (d4 == 0 && on(a, b, d));
+}
+
+// Whether the closed polygon (no repeated consecutive points, no collinear ones) is simple: no
+// two edges meet except neighbours at their common vertex.
+bool simple(const Polygon& pts) {
+  const std::size_t n = pts.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbours through the closing edge
+      if (segments_meet(pts[i], pts[(i + 1) % n], pts[j], pts[(j + 1) % n])) return false;
+    }
+  }
+  return true;
+}
+
+// The triangles whose union is the simple polygon `pts` (ear clipping; collinear points and
+// repeats dropped), or none when its edges cross (which side is inside is then a guess) or
+// rounding leaves no ear: the caller keeps the convex hull then, which covers every reading.
+std::vector<std::array<Vec2, 3>> triangulate(Polygon pts) {
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  while (pts.size() > 1 && pts.front() == pts.back()) pts.pop_back();
+  for (bool removed = true; removed && pts.size() >= 3;) {
+    removed = false;
+    for (std::size_t i = 0; i < pts.size() && pts.size() >= 3; ++i) {
+      const std::size_t n = pts.size();
+      if (cross(pts[(i + n - 1) % n], pts[i], pts[(i + 1) % n]) == 0.0) {
+        pts.erase(pts.begin() + static_cast<std::ptrdiff_t>(i));
+        removed = true;
+      }
+    }
+  }
+  if (pts.size() < 3 || !simple(pts)) return {};
+  if (signed_area(pts) < 0.0) std::reverse(pts.begin(), pts.end());
+  // A convex vertex whose triangle holds no other vertex (on its edges included) is an ear, cut
+  // off; a simple polygon of 4 or more vertices always has two.
+  std::vector<std::array<Vec2, 3>> out;
+  while (pts.size() > 3) {
+    const std::size_t n = pts.size();
+    bool cut = false;
+    for (std::size_t i = 0; i < n && !cut; ++i) {
+      const Vec2& a = pts[(i + n - 1) % n];
+      const Vec2& b = pts[i];
+      const Vec2& c = pts[(i + 1) % n];
+      if (cross(a, b, c) <= 0.0) continue;  // reflex (or flat): not an ear
+      bool empty = true;
+      for (std::size_t k = 0; k < n && empty; ++k) {
+        if (k == i || k == (i + n - 1) % n || k == (i + 1) % n) continue;
+        const Vec2& p = pts[k];
+        empty = !(cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0);
+      }
+      if (!empty) continue;
+      out.push_back({a, b, c});
+      pts.erase(pts.begin() + static_cast<std::ptrdiff_t>(i));
+      cut = true;
+    }
+    if (!cut) return {};
+  }
+  if (cross(pts[0], pts[1], pts[2]) > 0.0) out.push_back({pts[0], pts[1], pts[2]});
+  return out;
+}
+
 // A vertical prism over a convex polygon (counter-clockwise) centred at its centroid, so that the
 // object transform carries the position.
 std::shared_ptr<fcl::Convexd> make_prism(const Polygon& hull, const Vec2& centre) {
@@ -67,12 +152,44 @@ fcl::Transform3d planar_transform(const Vec2& position, double yaw) {
   return tf;
 }
 
-struct PreparedObstacle {
-  std::int64_t id;
+// A convex shape FCL measures against, with its bounding circle.
+struct Piece {
   Vec2 centre;
-  double radius;  // bounding circle around centre
+  double radius{0.0};
   std::shared_ptr<fcl::Convexd> shape;
   std::unique_ptr<fcl::CollisionObjectd> object;
+};
+
+template <typename Points>
+void bound(const Points& points, Piece& piece) {
+  piece.centre = Vec2::Zero();
+  for (const Vec2& p : points) piece.centre += p;
+  piece.centre /= static_cast<double>(points.size());
+  for (const Vec2& p : points) piece.radius = std::max(piece.radius, (p - piece.centre).norm());
+}
+
+// A convex polygon (counter-clockwise) as a prism spanning the vehicle box's height. (FCL 0.7
+// has no distance between a box and a flat triangle: TriangleP answers "not supported".)
+Piece prism_piece(const Polygon& convex) {
+  Piece piece;
+  bound(convex, piece);
+  piece.shape = make_prism(convex, piece.centre);
+  piece.object = std::make_unique<fcl::CollisionObjectd>(piece.shape, planar_transform(piece.centre, 0.0));
+  return piece;
+}
+
+// The convex pieces of a non-convex object, made when a query first comes near it (most objects
+// of a large request never do): the decomposition and its FCL shapes cost far more than the hull.
+struct LazyPieces {
+  std::once_flag once;
+  Polygon polygon;
+  std::vector<Piece> pieces;
+};
+
+struct PreparedObstacle {
+  std::int64_t id;
+  Piece hull;                          // the object's convex hull (its centre: clearance_ahead's)
+  std::unique_ptr<LazyPieces> pieces;  // null for a convex object (the hull is the object)
 };
 
 }  // namespace
@@ -92,15 +209,18 @@ ObjectChecker::ObjectChecker(const Footprint& vehicle, std::vector<Obstacle> obs
   impl_->box_radius = 0.5 * std::hypot(vehicle.length(), vehicle.width());
   impl_->box = std::make_shared<fcl::Boxd>(vehicle.length(), vehicle.width(), kPrismHeight);
   for (Obstacle& o : obstacles) {
-    Polygon hull = convex_hull(std::move(o.polygon));
+    const Polygon hull = convex_hull(o.polygon);
     if (hull.size() < 3) continue;  // degenerate: validation rejects such objects earlier
-    Vec2 centre = Vec2::Zero();
-    for (const Vec2& p : hull) centre += p;
-    centre /= static_cast<double>(hull.size());
-    double radius = 0.0;
-    for (const Vec2& p : hull) radius = std::max(radius, (p - centre).norm());
-    PreparedObstacle prepared{o.id, centre, radius, make_prism(hull, centre), nullptr};
-    prepared.object = std::make_unique<fcl::CollisionObjectd>(prepared.shape, planar_transform(centre, 0.0));
+    PreparedObstacle prepared{o.id, prism_piece(hull), nullptr};
+    // Convex (its hull has all of its distinct points): the hull is the object.
+    Polygon distinct = o.polygon;
+    std::sort(distinct.begin(), distinct.end(),
+              [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    if (distinct.size() != hull.size()) {
+      prepared.pieces = std::make_unique<LazyPieces>();
+      prepared.pieces->polygon = std::move(o.polygon);
+    }
     impl_->obstacles.push_back(std::move(prepared));
   }
 }
@@ -131,16 +251,31 @@ ObjectChecker::Clearance ObjectChecker::clearance_if(const Pose2& pose, double h
   // FCL 0.7's libccd distance for box-convex pairs is off by up to 0.4 m (tests/planners/
   // test_object_checker.cpp catches it); its own GJK implementation is exact to 1e-6 m.
   request.gjk_solver_type = fcl::GST_INDEP;
-  for (const PreparedObstacle& o : impl_->obstacles) {
-    if (!keep(o.centre)) continue;
-    // Lower bound of the distance from the two bounding circles.
-    const double lower = (o.centre - box_centre).norm() - o.radius - impl_->box_radius;
-    if (lower >= horizon || lower >= best.distance) continue;
+  // The distance to `piece` when it may be below both the horizon and the best so far (the
+  // bounding circles first), else +inf. Without signed distance FCL reports a negative value for
+  // overlapping shapes.
+  const auto measure = [&](const Piece& piece) {
+    const double lower = (piece.centre - box_centre).norm() - piece.radius - impl_->box_radius;
+    if (lower >= horizon || lower >= best.distance) return std::numeric_limits<double>::infinity();
     if (!vehicle) vehicle.emplace(impl_->box, planar_transform(box_centre, pose.yaw));
     fcl::DistanceResultd result;
-    fcl::distance(&*vehicle, o.object.get(), request, result);
-    // Without signed distance FCL reports a negative value for overlapping shapes.
-    const double d = std::max(result.min_distance, 0.0);
+    fcl::distance(&*vehicle, piece.object.get(), request, result);
+    return std::max(result.min_distance, 0.0);
+  };
+  for (const PreparedObstacle& o : impl_->obstacles) {
+    if (!keep(o.hull.centre)) continue;
+    double d = measure(o.hull);
+    // A non-convex object is no nearer than its hull: its pieces only where the hull is near.
+    if (o.pieces != nullptr && d < horizon && d < best.distance) {
+      LazyPieces& lazy = *o.pieces;
+      std::call_once(lazy.once, [&lazy] {
+        for (const auto& t : triangulate(lazy.polygon)) lazy.pieces.push_back(prism_piece({t[0], t[1], t[2]}));
+      });
+      if (!lazy.pieces.empty()) {  // (none: edges that cross, the hull stands for it)
+        d = std::numeric_limits<double>::infinity();
+        for (const Piece& piece : lazy.pieces) d = std::min(d, measure(piece));
+      }
+    }
     if (d < best.distance && d < horizon) {
       best.distance = d;
       best.obstacle_id = o.id;

@@ -19,7 +19,9 @@ namespace pullout {
 
 struct Obstacle {
   std::int64_t id{0};
-  Polygon polygon;  // convex, map frame; non-convex input is replaced by its convex hull
+  // Map frame. A non-convex one is checked exactly (as convex pieces whose union it is), unless
+  // its edges cross: then its convex hull, which covers every reading of it.
+  Polygon polygon;
 };
 
 class ObjectChecker {
