@@ -16,11 +16,12 @@ namespace pullout {
 namespace {
 
 // A PGM header (magic, width, height, maxval and their comments) is read from the file's first
-// kMaxHeaderBytes; a P2 raster from at most kMaxP2BytesPerPixel per pixel (a value of up to 5
-// digits and its whitespace, with room for much more). A file is read no further: a wrong path
-// naming a large file costs what the image would.
+// kMaxHeaderBytes; a P2 raster from at most kMaxP2BytesPerPixel per pixel and kMaxHeaderBytes
+// more (a value has up to 5 digits and its whitespace; padded columns fit too). A file is read no
+// further: a wrong path naming a large file costs what the image would (a P2 image of
+// max_grid_cells, 16 Mi, at most 256 MiB of text).
 constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
-constexpr std::size_t kMaxP2BytesPerPixel = 32;
+constexpr std::size_t kMaxP2BytesPerPixel = 16;
 
 bool resolution_ok(double resolution) {
   return resolution >= kMinGridResolution && resolution <= kMaxGridResolution;  // false for NaN
@@ -36,7 +37,10 @@ std::string cell_limit(std::size_t max_cells) {
   return std::to_string(max_cells) + " cells (service.limits.max_grid_cells)";
 }
 
-// The next header token of a PGM file, skipping whitespace and '#' comments.
+// The next header token of a PGM file, skipping whitespace and '#' comments. A token is cut after
+// kMaxTokenBytes (no number of a PGM file is longer): 256 MiB of NUL bytes where a P2 raster
+// should be grew one token of that size, char by char (2.6 s, 810 MB).
+constexpr std::size_t kMaxTokenBytes = 16;
 bool next_token(const std::string& data, std::size_t& pos, std::string& token) {
   token.clear();
   while (pos < data.size()) {
@@ -49,7 +53,10 @@ bool next_token(const std::string& data, std::size_t& pos, std::string& token) {
       break;
     }
   }
-  while (pos < data.size() && std::isspace(static_cast<unsigned char>(data[pos])) == 0) token += data[pos++];
+  while (pos < data.size() && token.size() < kMaxTokenBytes &&
+         std::isspace(static_cast<unsigned char>(data[pos])) == 0) {
+    token += data[pos++];
+  }
   return !token.empty();
 }
 
@@ -125,7 +132,7 @@ bool parse_pgm(std::ifstream& in, std::size_t file_size, const std::string& file
           bytes == 1 ? b0 : static_cast<std::uint16_t>((b0 << 8) | static_cast<unsigned char>(raster[i * 2 + 1]));
     }
   } else {
-    raster = read_at(in, pos, std::min(file_size - pos, n * kMaxP2BytesPerPixel));
+    raster = read_at(in, pos, std::min(file_size - pos, n * kMaxP2BytesPerPixel + kMaxHeaderBytes));
     out.pixels.assign(n, 0);
     std::size_t at = 0;
     std::string t;
