@@ -257,6 +257,28 @@ TEST(BoundedWork, CostmapBuildHonoursTheStopCondition) {
   EXPECT_FALSE(small.occupied(1, 1));
 }
 
+// One obstacle polygon may cover most of a grid of max_grid_cells, and the stop condition was
+// checked every 64 polygons only: 64 objects of a request, 64-point zigzags across a 4096 x 4096
+// grid of 0.01 m cells, kept a planning thread 3.5 to 5.2 s past a 200 ms deadline (about 60 ms
+// a polygon). Now the build stops within 64 rows of one polygon once the budget has run out.
+TEST(BoundedWork, CostmapObstaclesHonourTheStopConditionWithinAPolygon) {
+  OccupancyGrid grid;
+  grid.resolution_m = 0.01;
+  grid.width = 4096;
+  grid.height = 4096;
+  grid.data.assign(std::size_t{4096} * 4096, 0);
+  std::vector<Polygon> zigzags;
+  for (int j = 0; j < 64; ++j) {
+    Polygon p;
+    for (int k = 0; k < 64; ++k) p.push_back({(k % 2) * 40.96, 40.96 * k / 64.0 + j * 0.001});
+    zigzags.push_back(p);
+  }
+  Costmap map = Costmap::from_occupancy_grid(grid, 30);
+  map.add_obstacles(zigzags, StopCondition::after_ms(200.0));
+  EXPECT_EQ(map.stopped(), StopReason::kDeadline);
+  EXPECT_LT(map.shapes().size(), zigzags.size()) << "every polygon was drawn before the first check";
+}
+
 // A grid's cell size is bounded before anything is built from it: a fuzzed 1e-308 m cell once
 // overflowed the collision checker's cell counts (UBSan, fuzz_request).
 TEST(BoundedWork, GridCellSizeIsBoundedNamingTheField) {

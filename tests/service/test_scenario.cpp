@@ -1,6 +1,8 @@
 // Loading of scenario files.
 #include "pullout/config/scenario.hpp"
 
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -307,14 +309,15 @@ TEST(Scenario, GridFromObstacleShapes) {
 }
 
 TEST(Scenario, GridObstacleOutsideTheGridIsAnError) {
-  // 1e300 (or a typo) would otherwise be dropped silently, leaving a free grid and a path.
+  // A typo or wrong units would otherwise be dropped silently, leaving a free grid and a path
+  // (1e300 is beyond the coordinate limit: GridObstacleCoordinatesAreBounded).
   const auto p = problems_of(std::string(kPoses) +
                              "grid:\n  resolution: 0.5\n  origin: {x: -1.0, y: -2.0}\n  size: [10, 5]\n"
-                             "  obstacles:\n    - {x: 1e300, y: 0.0, length: 1.0, width: 1.0}\n"
+                             "  obstacles:\n    - {x: 1e6, y: 0.0, length: 1.0, width: 1.0}\n"
                              "    - {x: 2.0, y: 0.0, length: 1.0, width: 1.0}\n"
                              "    - {polygon: [[20, 0], [21, 0], [21, 1]]}\n"
                              "    - {x: 9.4, y: 3.4, length: 1.0, width: 1.0}\n");
-  EXPECT_TRUE(any_starts_with(p, "grid.obstacles[0] (at x 1e+300, y 0): lies entirely outside the grid")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles[0] (at x 1e+06, y 0): lies entirely outside the grid")) << dump(p);
   EXPECT_TRUE(any_starts_with(p, "grid.obstacles[2].polygon: lies entirely outside the grid")) << dump(p);
   EXPECT_EQ(p.size(), 2u) << dump(p);  // [1] inside, [3] reaches in from the far corner
 }
@@ -383,6 +386,116 @@ TEST(Scenario, GridFilesThatAreDirectoriesAreProblems) {
   std::ofstream(dir / "scenario.yaml") << kPoses << "grid: {map: lot.yaml}\n";
   p = problems_of_file((dir / "scenario.yaml").string());
   EXPECT_TRUE(any_starts_with(p, (dir / "images").string() + ": cannot read file")) << dump(p);
+  std::filesystem::remove_all(dir);
+}
+
+// A scenario's grid is bounded by the request limit the planner applies (service.limits.
+// max_grid_cells): the loader allowed 4 times as many cells, so an 8192 x 8192 grid cost 1.1 s
+// and 230 MB to build, then was rejected by the planner, or (pullout request) sent as a 64 MB
+// sample the service drops unanswered.
+TEST(Scenario, GridCellsAreBoundedByTheRequestLimit) {
+  auto p = problems_of(std::string(kPoses) + "grid:\n  resolution: 0.01\n  size: [40.97, 40.96]\n");
+  EXPECT_TRUE(any_starts_with(p,
+                              "grid.size: must give 1 to 16777216 cells (service.limits.max_grid_cells), got "
+                              "4097 x 4096 = 16781312"))
+      << dump(p);
+
+  Config base;
+  base.service.limits.max_grid_cells = 100;
+  ScenarioFile file(std::string(kPoses) + "grid:\n  resolution: 0.5\n  size: [10, 5]\n");
+  try {
+    load_scenario(file.path(), base);
+    ADD_FAILURE() << "200 cells over a limit of 100 loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_TRUE(any_starts_with(e.problems(), "grid.size: must give 1 to 100 cells")) << dump(e.problems());
+  }
+
+  // A map_server image is checked against the limit from its header, before its pixels are read.
+  const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_big_map_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "lot.pgm", std::ios::binary) << "P5\n20 10\n255\n" << std::string(200, '\xff');
+  std::ofstream(dir / "lot.yaml") << "image: lot.pgm\nresolution: 0.5\norigin: [0.0, 0.0, 0.0]\n";
+  std::ofstream(dir / "scenario.yaml") << kPoses << "grid: {map: lot.yaml}\n";
+  try {
+    load_scenario((dir / "scenario.yaml").string(), base);
+    ADD_FAILURE() << "a 20 x 10 image over a limit of 100 cells loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_TRUE(any_starts_with(e.problems(), (dir / "lot.pgm").string() +
+                                                  ": 20 x 10 pixels exceed the limit of 100 cells "
+                                                  "(service.limits.max_grid_cells)"))
+        << dump(e.problems());
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// Obstacle shapes are bounded like every coordinate of a request (service.limits.max_coordinate_m):
+// a box 1e100 m long lost its position and width to rounding (its corners 8.7e93 m out) and was
+// drawn along the grid's bottom row instead of across its middle, and corners of 1.7e308 m
+// overflowed to infinity in the grid frame and drew nothing: both gave a path through the wall.
+TEST(Scenario, GridObstacleCoordinatesAreBounded) {
+  const std::string grid = std::string(kPoses) + "grid:\n  resolution: 0.2\n  size: [30, 30]\n  obstacles:\n";
+  auto p = problems_of(grid +
+                       "    - {x: 15, y: 15, yaw_deg: 0.0001, length: 1e100, width: 2}\n"
+                       "    - {polygon: [[-1.7e308, 14], [1.7e308, 14], [1.7e308, 16], [-1.7e308, 16]]}\n"
+                       "    - {x: 15, y: -2e7, length: 1, width: 3e7}\n");
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles[0].length: 1e+100 exceeds 1e+07 m")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles[1].polygon[0].x: |x| 1.7e+308 exceeds 1e+07 m")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles[2].y: |y| 2e+07 exceeds 1e+07 m")) << dump(p);
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles[2].width: 3e+07 exceeds 1e+07 m")) << dump(p);
+
+  // At the limit the wall stays where it is: across the middle of the grid.
+  ScenarioFile file(grid + "    - {x: 15, y: 15, yaw_deg: 0.0001, length: 1e7, width: 2}\n");
+  const Scenario s = load_scenario(file.path());
+  const OccupancyGrid& g = *s.request.occupancy_grid;
+  EXPECT_EQ(g.data[static_cast<std::size_t>(15.0 / 0.2) * g.width + 10], 100);  // x 2, y 15
+  EXPECT_EQ(g.data[static_cast<std::size_t>(5.0 / 0.2) * g.width + 10], 0);     // x 2, y 5
+  EXPECT_EQ(g.data[10], 0);                                                     // x 2, y 0.1
+}
+
+// The image of a map_server grid is read no further than its header says: the whole file was read
+// into memory first, so that an image path naming a 2 GB file cost 20 s and 4 GB (6 GB when it
+// was no image at all). A FIFO blocked the loader for good (opened before it was checked), and a
+// file that fails to read (/proc/self/mem) threw std::ios_failure out of load_scenario.
+TEST(Scenario, GridImageCostsNoMoreThanItsHeaderDeclares) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_image_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "scenario.yaml") << kPoses << "grid: {map: lot.yaml}\n";
+  const auto image = [&](const std::string& file) {
+    std::ofstream(dir / "lot.yaml") << "image: " << file << "\nresolution: 0.5\norigin: [0.0, 0.0, 0.0]\n";
+  };
+  const auto scenario = (dir / "scenario.yaml").string();
+
+  // 4 x 3 pixels, then 512 MiB of nothing (sparse): the image loads, and the rest is not read.
+  std::ofstream(dir / "lot.pgm", std::ios::binary) << "P5\n4 3\n255\n" << std::string(12, '\xff');
+  std::filesystem::resize_file(dir / "lot.pgm", std::uintmax_t{512} << 20);
+  image("lot.pgm");
+  const Scenario s = load_scenario(scenario);
+  EXPECT_EQ(s.request.occupancy_grid->data, std::vector<std::int8_t>(12, 0));
+  rusage usage{};
+  ASSERT_EQ(getrusage(RUSAGE_SELF, &usage), 0);
+  EXPECT_LT(usage.ru_maxrss, 256L * 1024) << "peak resident set [KiB]";
+
+  // A header declaring more than the file holds is found before the pixels are allocated.
+  std::ofstream(dir / "lot.pgm", std::ios::binary | std::ios::trunc) << "P5\n4000 4000\n65535\n"
+                                                                     << std::string(10, 'x');
+  auto p = problems_of_file(scenario);
+  EXPECT_TRUE(any_starts_with(
+      p, (dir / "lot.pgm").string() + ": truncated PGM data: 4000 x 4000 pixels need 32000000 bytes, the file has 10"))
+      << dump(p);
+
+  ASSERT_EQ(::mkfifo((dir / "fifo.pgm").c_str(), 0600), 0);
+  image("fifo.pgm");
+  p = problems_of_file(scenario);
+  EXPECT_TRUE(any_starts_with(p, (dir / "fifo.pgm").string() + ": cannot read file (not a regular file)")) << dump(p);
+
+  if (std::filesystem::exists("/proc/self/mem")) {
+    image("/proc/self/mem");
+    p = problems_of_file(scenario);
+    EXPECT_TRUE(any_starts_with(p, "/proc/self/mem: not a PGM image")) << dump(p);
+    std::ofstream(dir / "scenario.yaml") << kPoses << "grid: {map: /proc/self/mem}\n";
+    p = problems_of_file(scenario);
+    EXPECT_TRUE(any_starts_with(p, "grid.map: /proc/self/mem: cannot read file")) << dump(p);
+  }
   std::filesystem::remove_all(dir);
 }
 

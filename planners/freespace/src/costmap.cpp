@@ -324,6 +324,8 @@ bool Costmap::mark(const std::vector<Polygon>& polygons, const StopCondition& st
     const int r1 = clamped_int(std::floor(y_hi), -1, height_ - 1);
     auto edge_it = edge_cells.begin();
     for (int j = r0; j <= r1; ++j) {
+      // One polygon may cover the whole grid (max_grid_cells): checked every 64 of its rows too.
+      if (j > r0 && stop_now(stop, j - r0, stopped_)) return false;
       const double y = j + 0.5;
       crossings.clear();
       for (std::size_t k = 0, m = g.size() - 1; k < g.size(); m = k++) {
@@ -399,6 +401,11 @@ void Costmap::precompute(const StopCondition& stop) {
   hard_box_ = BoxCounts();
   distance_ = DistanceField();
   if (!partial_.empty()) {
+    // The list holds up to 64 edges x (width + height) entries per polygon: tens of millions.
+    if (const StopReason reason = stop.check(); reason != StopReason::kNone) {
+      stopped_ = reason;
+      return;
+    }
     std::sort(partial_.begin(), partial_.end());
     partial_.erase(std::unique(partial_.begin(), partial_.end()), partial_.end());
     // A cell made hard by a later shape needs no exact test.

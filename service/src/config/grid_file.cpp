@@ -15,7 +15,13 @@ namespace pullout {
 
 namespace {
 
-constexpr long kMaxCells = 64L * 1024L * 1024L;
+// A PGM header (magic, width, height, maxval and their comments) is read from the file's first
+// kMaxHeaderBytes; a P2 raster from at most kMaxP2BytesPerPixel per pixel and kMaxHeaderBytes
+// more (a value has up to 5 digits and its whitespace; padded columns fit too). A file is read no
+// further: a wrong path naming a large file costs what the image would (a P2 image of
+// max_grid_cells, 16 Mi, at most 256 MiB of text).
+constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
+constexpr std::size_t kMaxP2BytesPerPixel = 16;
 
 bool resolution_ok(double resolution) {
   return resolution >= kMinGridResolution && resolution <= kMaxGridResolution;  // false for NaN
@@ -27,7 +33,14 @@ std::string resolution_range() {
   return os.str();
 }
 
-// The next header token of a PGM file, skipping whitespace and '#' comments.
+std::string cell_limit(std::size_t max_cells) {
+  return std::to_string(max_cells) + " cells (service.limits.max_grid_cells)";
+}
+
+// The next header token of a PGM file, skipping whitespace and '#' comments. A token is cut after
+// kMaxTokenBytes (no number of a PGM file is longer): 256 MiB of NUL bytes where a P2 raster
+// should be grew one token of that size, char by char (2.6 s, 810 MB).
+constexpr std::size_t kMaxTokenBytes = 16;
 bool next_token(const std::string& data, std::size_t& pos, std::string& token) {
   token.clear();
   while (pos < data.size()) {
@@ -40,7 +53,10 @@ bool next_token(const std::string& data, std::size_t& pos, std::string& token) {
       break;
     }
   }
-  while (pos < data.size() && std::isspace(static_cast<unsigned char>(data[pos])) == 0) token += data[pos++];
+  while (pos < data.size() && token.size() < kMaxTokenBytes &&
+         std::isspace(static_cast<unsigned char>(data[pos])) == 0) {
+    token += data[pos++];
+  }
   return !token.empty();
 }
 
@@ -53,63 +69,114 @@ bool parse_int(const std::string& s, long& v) {
   return true;
 }
 
-}  // namespace
+// Up to `count` bytes of `in` from `offset` (fewer at the end of the file).
+std::string read_at(std::ifstream& in, std::size_t offset, std::size_t count) {
+  std::string bytes(count, '\0');
+  in.clear();
+  in.seekg(static_cast<std::streamoff>(offset));
+  in.read(bytes.data(), static_cast<std::streamsize>(count));
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return bytes;
+}
 
-bool read_pgm(const std::string& file, PgmImage& out, std::vector<std::string>& problems) {
-  std::ifstream in(file, std::ios::binary);
-  // A directory opens, and reading it throws std::ios_failure.
-  std::error_code ec;
-  if (!in || !std::filesystem::is_regular_file(file, ec)) {
-    problems.push_back(file + ": cannot read file");
-    return false;
-  }
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+// |v| within the request limit of coordinates (see RequestLimits::max_coordinate_m): beyond it a
+// shape's corners lose its position and width to rounding, or overflow in the grid frame.
+void check_extent(double v, const std::string& field, const char* what, const RequestLimits& limits,
+                  std::vector<std::string>& problems) {
+  if (std::abs(v) <= limits.max_coordinate_m) return;
+  std::ostringstream os;
+  os << field << ": " << what << std::abs(v) << " exceeds " << limits.max_coordinate_m << " m";
+  problems.push_back(os.str());
+}
+
+bool parse_pgm(std::ifstream& in, std::size_t file_size, const std::string& file, std::size_t max_cells, PgmImage& out,
+               std::vector<std::string>& problems) {
+  const std::string head = read_at(in, 0, std::min(file_size, kMaxHeaderBytes));
   std::size_t pos = 0;
   std::string magic, tw, th, tm;
   long w = 0, h = 0, maxval = 0;
-  if (!next_token(data, pos, magic) || (magic != "P5" && magic != "P2")) {
+  if (!next_token(head, pos, magic) || (magic != "P5" && magic != "P2")) {
     problems.push_back(file + ": not a PGM image (expected P5 or P2)");
     return false;
   }
-  if (!next_token(data, pos, tw) || !next_token(data, pos, th) || !next_token(data, pos, tm) || !parse_int(tw, w) ||
+  // The whitespace after maxval lies within `head`, so no token was cut at its end.
+  if (!next_token(head, pos, tw) || !next_token(head, pos, th) || !next_token(head, pos, tm) || !parse_int(tw, w) ||
       !parse_int(th, h) || !parse_int(tm, maxval) || w < 1 || h < 1 || maxval < 1 || maxval > 65535 ||
-      w * h > kMaxCells) {
+      pos >= head.size()) {
     problems.push_back(file + ": bad PGM header (width, height, maxval in 1..65535)");
     return false;
   }
-  out.width = static_cast<int>(w);
-  out.height = static_cast<int>(h);
-  out.max_value = static_cast<int>(maxval);
-  const std::size_t n = static_cast<std::size_t>(w * h);
-  out.pixels.assign(n, 0);
+  const auto n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);  // < 1e18: 9 digits each
+  if (n > max_cells) {
+    problems.push_back(file + ": " + tw + " x " + th + " pixels exceed the limit of " + cell_limit(max_cells));
+    return false;
+  }
+  std::string raster;
   if (magic == "P5") {
-    ++pos;  // the single whitespace after maxval
+    const std::size_t start = pos + 1;  // after the single whitespace after maxval
     const std::size_t bytes = maxval > 255 ? 2 : 1;
-    if (data.size() < pos + n * bytes) {
-      problems.push_back(file + ": truncated PGM data");
+    if (file_size < start + n * bytes) {
+      problems.push_back(file + ": truncated PGM data: " + tw + " x " + th + " pixels need " +
+                         std::to_string(n * bytes) + " bytes, the file has " + std::to_string(file_size - start));
       return false;
     }
+    raster = read_at(in, start, n * bytes);
+    if (raster.size() != n * bytes) {
+      problems.push_back(file + ": cannot read file (it ended before its size)");
+      return false;
+    }
+    out.pixels.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
-      const auto b0 = static_cast<unsigned char>(data[pos + i * bytes]);
+      const auto b0 = static_cast<unsigned char>(raster[i * bytes]);
       out.pixels[i] =
-          bytes == 1 ? b0 : static_cast<std::uint16_t>((b0 << 8) | static_cast<unsigned char>(data[pos + i * 2 + 1]));
+          bytes == 1 ? b0 : static_cast<std::uint16_t>((b0 << 8) | static_cast<unsigned char>(raster[i * 2 + 1]));
     }
   } else {
+    raster = read_at(in, pos, std::min(file_size - pos, n * kMaxP2BytesPerPixel + kMaxHeaderBytes));
+    out.pixels.assign(n, 0);
+    std::size_t at = 0;
     std::string t;
     for (std::size_t i = 0; i < n; ++i) {
       long v = 0;
-      if (!next_token(data, pos, t) || !parse_int(t, v) || v > maxval) {
+      if (!next_token(raster, at, t) || !parse_int(t, v) || v > maxval) {
         problems.push_back(file + ": bad or missing pixel " + std::to_string(i) + " in P2 data");
         return false;
       }
       out.pixels[i] = static_cast<std::uint16_t>(v);
     }
   }
+  out.width = static_cast<int>(w);
+  out.height = static_cast<int>(h);
+  out.max_value = static_cast<int>(maxval);
   return true;
 }
 
-bool load_map_server_grid(const std::string& yaml_file, const std::string& key_path, OccupancyGrid& out,
-                          std::vector<std::string>& problems) {
+}  // namespace
+
+bool read_pgm(const std::string& file, std::size_t max_cells, PgmImage& out, std::vector<std::string>& problems) {
+  // Checked before opening: opening a FIFO waits for a writer, reading a directory throws.
+  std::error_code ec;
+  const bool regular = std::filesystem::is_regular_file(file, ec);
+  const std::uintmax_t size = regular ? std::filesystem::file_size(file, ec) : 0;
+  if (!regular || ec) {
+    problems.push_back(file + ": cannot read file (not a regular file)");
+    return false;
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    problems.push_back(file + ": cannot read file");
+    return false;
+  }
+  try {
+    return parse_pgm(in, static_cast<std::size_t>(size), file, max_cells, out, problems);
+  } catch (const std::exception& e) {  // libstdc++ throws std::ios_failure on a read error (EIO)
+    problems.push_back(file + ": cannot read file (" + e.what() + ")");
+    return false;
+  }
+}
+
+bool load_map_server_grid(const std::string& yaml_file, const std::string& key_path, const RequestLimits& limits,
+                          OccupancyGrid& out, std::vector<std::string>& problems) {
   YAML::Node doc;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(yaml_file, ec)) {  // a directory opens, and reading it throws
@@ -120,6 +187,9 @@ bool load_map_server_grid(const std::string& yaml_file, const std::string& key_p
     doc = YAML::LoadFile(yaml_file);
   } catch (const YAML::Exception& e) {
     problems.push_back(key_path + ": " + yaml_file + ": " + e.what());
+    return false;
+  } catch (const std::exception& e) {  // a read error (EIO, /proc/self/mem): std::ios_failure
+    problems.push_back(key_path + ": " + yaml_file + ": cannot read file (" + e.what() + ")");
     return false;
   }
   const std::size_t before = problems.size();
@@ -158,7 +228,7 @@ bool load_map_server_grid(const std::string& yaml_file, const std::string& key_p
   std::filesystem::path img(image);
   if (img.is_relative()) img = std::filesystem::path(yaml_file).parent_path() / img;
   PgmImage pgm;
-  if (!read_pgm(img.string(), pgm, problems)) return false;
+  if (!read_pgm(img.string(), limits.max_grid_cells, pgm, problems)) return false;
   out.resolution_m = resolution;
   out.origin = origin;
   out.width = static_cast<std::uint32_t>(pgm.width);
@@ -175,7 +245,8 @@ bool load_map_server_grid(const std::string& yaml_file, const std::string& key_p
   return true;
 }
 
-bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_dir, OccupancyGrid& out) {
+bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_dir, const RequestLimits& limits,
+                        OccupancyGrid& out) {
   yaml_fields::MapReader r(parent.get("grid"), "grid", parent.problems());
   if (!r.valid()) return false;
   auto& problems = r.problems();
@@ -186,7 +257,7 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
     r.finish();
     std::filesystem::path path(file);
     if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
-    return load_map_server_grid(path.string(), "grid.map", out, problems);
+    return load_map_server_grid(path.string(), "grid.map", limits, out, problems);
   }
   double resolution = 0.2;
   r.read("resolution", resolution);
@@ -229,8 +300,11 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
           problems.push_back(yaml_fields::indexed(path + ".polygon", k) + ": expected [x, y]");
           continue;
         }
-        const auto x = yaml_fields::to_double(pts[k][0], path + ".polygon.x", problems);
-        const auto y = yaml_fields::to_double(pts[k][1], path + ".polygon.y", problems);
+        const std::string point = yaml_fields::indexed(path + ".polygon", k);
+        const auto x = yaml_fields::to_double(pts[k][0], point + ".x", problems);
+        const auto y = yaml_fields::to_double(pts[k][1], point + ".y", problems);
+        if (x) check_extent(*x, point + ".x", "|x| ", limits, problems);
+        if (y) check_extent(*y, point + ".y", "|y| ", limits, problems);
         if (x && y) poly.push_back({*x, *y});
       }
       if (poly.size() < 3) problems.push_back(path + ".polygon: needs at least 3 points");
@@ -245,6 +319,10 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
       b.read("length", box.length_m);
       b.read("width", box.width_m);
       if (!(box.length_m > 0.0 && box.width_m > 0.0)) problems.push_back(path + ": length and width must be > 0");
+      check_extent(box.pose.x, path + ".x", "|x| ", limits, problems);
+      check_extent(box.pose.y, path + ".y", "|y| ", limits, problems);
+      check_extent(box.length_m, path + ".length", "", limits, problems);
+      check_extent(box.width_m, path + ".width", "", limits, problems);
       shapes.push_back(object_polygon(box));
       std::ostringstream where;
       where << path << " (at x " << box.pose.x << ", y " << box.pose.y << ")";
@@ -257,8 +335,11 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
   // Cell counts in double: a size of any magnitude is checked before it becomes an int.
   const double cells_x = std::ceil(w / resolution - 1e-9);
   const double cells_y = std::ceil(h / resolution - 1e-9);
-  if (!(cells_x >= 1.0 && cells_y >= 1.0 && cells_x * cells_y <= static_cast<double>(kMaxCells))) {
-    problems.push_back("grid.size: must give 1 to " + std::to_string(kMaxCells) + " cells");
+  if (!(cells_x >= 1.0 && cells_y >= 1.0 && cells_x * cells_y <= static_cast<double>(limits.max_grid_cells))) {
+    std::ostringstream os;
+    os << "grid.size: must give 1 to " << cell_limit(limits.max_grid_cells) << ", got " << cells_x << " x " << cells_y;
+    if (cells_x * cells_y < 1e15) os << " = " << static_cast<long long>(cells_x * cells_y);
+    problems.push_back(os.str());
     return false;
   }
   const int cw = static_cast<int>(cells_x);

@@ -376,7 +376,7 @@ Scenario load_scenario(const std::string& path, const Config& base) {
   }
   if (root.has("grid")) {
     OccupancyGrid grid;
-    if (read_scenario_grid(root, std::filesystem::path(path).parent_path().string(), grid)) {
+    if (read_scenario_grid(root, std::filesystem::path(path).parent_path().string(), base.service.limits, grid)) {
       request.occupancy_grid = std::move(grid);
     }
   }

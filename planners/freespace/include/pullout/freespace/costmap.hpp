@@ -28,10 +28,10 @@
 //
 // Building costs O(cells) (up to 16384 x 16384 from polygons, max_grid_cells from a grid) and
 // honours a stop condition: it is checked before every drivable polygon, every 64 rows of the
-// rasterisation, every 64 obstacle polygons, and every 64 rows of the tables' sweeps. A build it
-// cuts short returns at once with stopped() set; such a costmap is incomplete and must not be
-// searched. The fills on first use take no stop condition: each is bounded (a band of 64 rows, a
-// row segment).
+// rasterisation, every 64 obstacle polygons and every 64 rows of one, before the exact layer's
+// list is sorted, and every 64 rows of the tables' sweeps. A build it cuts short returns at once
+// with stopped() set; such a costmap is incomplete and must not be searched. The fills on first use take no stop
+// condition: each is bounded (a band of 64 rows, a row segment).
 #pragma once
 
 #include <cstdint>
