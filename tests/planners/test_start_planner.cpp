@@ -10,6 +10,7 @@
 #include "pullout/collision/footprint.hpp"
 #include "pullout/collision/object_checker.hpp"
 #include "pullout/config/scenario.hpp"
+#include "pullout/geometry/angle.hpp"
 #include "pullout/lanes/lane_world.hpp"
 #include "pullout/model/names.hpp"
 #include "test_world.hpp"
@@ -252,6 +253,25 @@ TEST(StartPlannerOutcomes, CancelledSearchGivesACancelledRow) {
   EXPECT_EQ(r.stopped, StopReason::kCancelled);
   ASSERT_EQ(r.evaluation_table.size(), 1u);
   EXPECT_EQ(r.evaluation_table[0].outcome, AttemptOutcome::kCancelled);
+}
+
+// A grid-only request whose start or goal the search refuses says which and why: outside the
+// grid, or the vehicle there meets an obstacle (the row said only "to the goal").
+TEST(StartPlannerOutcomes, ARefusedStartOrGoalOfAGridSaysWhichAndWhy) {
+  const Scenario sc = load("freespace_parking_lot");  // grid only, 30 m x 30 m from the origin
+  const StartPlanner planner(sc.vehicle, sc.parameters);
+  const auto detail_of = [&](const Pose2& start, const Pose2& goal) {
+    PullOutRequest request = sc.request;
+    request.ego_pose = start;
+    request.goal_pose = goal;
+    const PlanningResult r = planner.plan(request, StopCondition());
+    EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
+    return r.evaluation_table.empty() ? std::string() : r.evaluation_table.back().detail;
+  };
+  // The start on the first parked car of the lower row (x 3, y 3).
+  EXPECT_EQ(detail_of({3.0, 3.0, kPi / 2}, sc.request.goal_pose),
+            "the start (x 3.00, y 3.00): the vehicle there meets an obstacle or the grid's edge");
+  EXPECT_EQ(detail_of(sc.request.ego_pose, {40.0, 26.0, 0.0}), "the goal (x 40.00, y 26.00) lies outside the grid");
 }
 
 TEST(StartPlannerOutcomes, CancelledLaneSearchStopsBeforeTheFirstAttempt) {

@@ -360,6 +360,28 @@ std::shared_ptr<const PlannedWorld> StartPlanner::planned_world(const PullOutReq
   return std::make_shared<const PlannedWorld>(PlannedWorld{std::move(lanes.lanes), request.objects, vehicle, nullptr});
 }
 
+namespace {
+
+// Why the freespace search refused its start or goal, in words a user can act on: the pose lies
+// outside the grid, or the vehicle there meets an obstacle or the grid's edge.
+std::string refused_pose(const Costmap& costmap, const Pose2& pose, const char* which) {
+  int i = 0;
+  int j = 0;
+  costmap.cell_of({pose.x, pose.y}, i, j);
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(2);
+  os << "the " << which << " (x " << pose.x << ", y " << pose.y << ")";
+  if (!costmap.inside(i, j)) {
+    os << " lies outside the grid";
+  } else {
+    os << ": the vehicle there meets an obstacle or the grid's edge";
+  }
+  return os.str();
+}
+
+}  // namespace
+
 bool StartPlanner::grid_only_allowed() const { return parameters_.freespace_planner.enable_freespace_planner; }
 
 PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const VehicleInfo& vehicle,
@@ -385,8 +407,14 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
     r = plan_freespace_to_goal(costmap, vehicle, p, request.ego_pose, request.goal_pose, stop, &plan_rrt_star);
   }
   const double margin = 0.5 * p.vehicle_shape_margin;
+  std::string detail = "to the goal";
+  if (r.status == HybridAStarResult::Status::kStartOccupied) {
+    detail = refused_pose(costmap, request.ego_pose, "start");
+  } else if (r.status == HybridAStarResult::Status::kGoalOccupied) {
+    detail = refused_pose(costmap, request.goal_pose, "goal");
+  }
   const Failure f =
-      r.stopped != StopReason::kNone ? stopped_failure(r.stopped) : Failure{attempt_outcome(r.status), "to the goal"};
+      r.stopped != StopReason::kNone ? stopped_failure(r.stopped) : Failure{attempt_outcome(r.status), detail};
   result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, f.outcome, f.detail});
   if (r.status == HybridAStarResult::Status::kSuccess) {
     result.outcome = PlanningResult::Outcome::kFound;
