@@ -299,6 +299,24 @@ TEST(BoundedWork, GridCellSizeIsBoundedNamingTheField) {
   EXPECT_EQ(r.outcome, PlanningResult::Outcome::kRejected);
 }
 
+// A grid's extent is bounded as every other extent of a request: one row of 16 Mi cells of 5 m
+// (84,000 km) is refused, naming the field, before anything is built from it.
+TEST(BoundedWork, GridExtentIsBoundedNamingTheField) {
+  PullOutRequest req = test::straight_shoulder_request();
+  const std::uint32_t long_side = 16U * 1024U * 1024U;
+  req.occupancy_grid = OccupancyGrid{5.0, {}, long_side, 1, std::vector<std::int8_t>(long_side, 0)};
+  const auto issues = planner().validate(req);
+  ASSERT_EQ(issues.size(), 1U) << format_issues(issues);
+  EXPECT_EQ(issues.front().field, "occupancy_grid.width");
+  EXPECT_EQ(issues.front().problem, "width x resolution_m 8.38861e+07 exceeds 1e+07 m");
+  req.occupancy_grid = OccupancyGrid{5.0, {}, 1, long_side, std::vector<std::int8_t>(long_side, 0)};
+  ASSERT_EQ(planner().validate(req).size(), 1U);
+  EXPECT_EQ(planner().validate(req).front().field, "occupancy_grid.height");
+  // 1 Mi cells of 5 m (5,243 km) are within the limit of 1e7 m.
+  req.occupancy_grid = OccupancyGrid{5.0, {}, 1024U * 1024U, 1, std::vector<std::int8_t>(1024U * 1024U, 0)};
+  EXPECT_TRUE(planner().validate(req).empty()) << format_issues(planner().validate(req));
+}
+
 // ---- the crop itself ----
 
 TEST(LaneCrop, KeepsTheStretchNearTheSquare) {

@@ -211,13 +211,19 @@ std::vector<RequestIssue> validate_request_structure(const PullOutRequest& r, co
   if (r.occupancy_grid) {
     const OccupancyGrid& g = *r.occupancy_grid;
     const std::size_t cells = static_cast<std::size_t>(g.width) * g.height;
-    if (c.finite("occupancy_grid.resolution_m", g.resolution_m) &&
-        !(g.resolution_m >= kMinGridResolution && g.resolution_m <= kMaxGridResolution)) {
+    const bool cell_ok = g.resolution_m >= kMinGridResolution && g.resolution_m <= kMaxGridResolution;
+    if (c.finite("occupancy_grid.resolution_m", g.resolution_m) && !cell_ok) {
       std::ostringstream os;
       os << g.resolution_m << " m is outside [" << kMinGridResolution << ", " << kMaxGridResolution << "] m";
       c.add("occupancy_grid.resolution_m", os.str());
     }
     c.pose("occupancy_grid.origin", g.origin);
+    // Its far edges within the coordinate limit too, as every other extent of a request (a grid of
+    // 16 Mi x 1 cells of 5 m reached 84,000 km from its origin).
+    if (cell_ok) {
+      c.within_extent("occupancy_grid.width", "width x resolution_m", g.width * g.resolution_m);
+      c.within_extent("occupancy_grid.height", "height x resolution_m", g.height * g.resolution_m);
+    }
     if (c.count("occupancy_grid", cells, limits.max_grid_cells, "cells") && g.data.size() != cells) {
       c.add("occupancy_grid.data",
             "has " + std::to_string(g.data.size()) + " cells, width x height is " + std::to_string(cells));
