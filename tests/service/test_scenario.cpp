@@ -452,6 +452,30 @@ TEST(Scenario, GridObstacleCoordinatesAreBounded) {
   EXPECT_EQ(g.data[10], 0);                                                     // x 2, y 0.1
 }
 
+// As many obstacle shapes and polygon points as a request's objects may have: drawing costs each
+// shape's area in cells (50,000 boxes took over a minute and 2.4 GB, one polygon of 20,000 points
+// 8 s), so more are refused before any is drawn, naming the limit.
+TEST(Scenario, GridObstacleCountsAreBoundedAsARequestsObjects) {
+  const std::string grid = std::string(kPoses) + "grid:\n  resolution: 0.2\n  size: [30, 30]\n  obstacles:\n";
+  std::string many;
+  for (int i = 0; i < 513; ++i) many += "    - {x: 15, y: 15, length: 1, width: 1}\n";
+  auto p = problems_of(grid + many);
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles: 513 shapes exceed the limit of 512 (service.limits.max_objects)"))
+      << dump(p);
+  std::string points = "    - {polygon: [";
+  for (int k = 0; k < 65; ++k)
+    points += (k > 0 ? ", [" : "[") + std::to_string(15.0 + std::cos(k * 0.0966)) + ", " +
+              std::to_string(15.0 + std::sin(k * 0.0966)) + "]";
+  p = problems_of(grid + points + "]}\n");
+  EXPECT_TRUE(any_starts_with(p,
+                              "grid.obstacles[0].polygon: 65 points exceed the limit of 64 "
+                              "(service.limits.max_polygon_points)"))
+      << dump(p);
+  // At the limits: loaded.
+  many.resize(many.size() / 513 * 512);
+  EXPECT_TRUE(problems_of(grid + many).empty());
+}
+
 // The image of a map_server grid is read no further than its header says: the whole file was read
 // into memory first, so that an image path naming a 2 GB file cost 20 s and 4 GB (6 GB when it
 // was no image at all). A FIFO blocked the loader for good (opened before it was checked), and a

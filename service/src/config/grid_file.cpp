@@ -288,6 +288,13 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
   const YAML::Node listed = r.get("obstacles");
   const YAML::Node obstacles = listed.IsDefined() ? listed : YAML::Node(YAML::NodeType::Sequence);
   if (!obstacles.IsSequence()) problems.push_back("grid.obstacles: expected a list");
+  // As many shapes and points as a request's objects may have (max_objects, max_polygon_points):
+  // drawing costs each shape's area in cells, and 50,000 boxes took over a minute and 2.4 GB.
+  if (obstacles.IsSequence() && obstacles.size() > limits.max_objects) {
+    problems.push_back("grid.obstacles: " + std::to_string(obstacles.size()) + " shapes exceed the limit of " +
+                       std::to_string(limits.max_objects) + " (service.limits.max_objects)");
+    return false;
+  }
   for (std::size_t i = 0; obstacles.IsSequence() && i < obstacles.size(); ++i) {
     const std::string path = yaml_fields::indexed("grid.obstacles", i);
     yaml_fields::MapReader b(obstacles[i], path, problems);
@@ -295,6 +302,11 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
     if (b.has("polygon")) {
       Polygon poly;
       const YAML::Node pts = b.get("polygon");
+      if (pts.IsSequence() && pts.size() > limits.max_polygon_points) {
+        problems.push_back(path + ".polygon: " + std::to_string(pts.size()) + " points exceed the limit of " +
+                           std::to_string(limits.max_polygon_points) + " (service.limits.max_polygon_points)");
+        continue;
+      }
       for (std::size_t k = 0; pts.IsSequence() && k < pts.size(); ++k) {
         if (!pts[k].IsSequence() || pts[k].size() != 2) {
           problems.push_back(yaml_fields::indexed(path + ".polygon", k) + ": expected [x, y]");
