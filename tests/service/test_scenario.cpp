@@ -476,6 +476,22 @@ TEST(Scenario, GridObstacleCountsAreBoundedAsARequestsObjects) {
   EXPECT_TRUE(problems_of(grid + many).empty());
 }
 
+// Within those limits drawing can still cost the shapes' area: 512 polygons zigzagging across a
+// grid of 16 Mi cells took 29 s and 640 MB. Past 2 s of drawing the file is refused, saying why.
+TEST(Scenario, DrawingAGridsObstaclesIsBoundedInTime) {
+  std::string text = std::string(kPoses) + "grid:\n  resolution: 0.01\n  size: [40.96, 40.96]\n  obstacles:\n";
+  for (int j = 0; j < 512; ++j) {
+    text += "    - {polygon: [";
+    for (int k = 0; k < 64; ++k) {
+      text += (k > 0 ? ", [" : "[") + std::to_string(k % 2 == 0 ? 0.0 : 40.96) + ", " +
+              std::to_string(0.64 * k + 0.001 * j) + "]";
+    }
+    text += "]}\n";
+  }
+  const auto p = problems_of(text);
+  EXPECT_TRUE(any_starts_with(p, "grid.obstacles: drawing them on 4096 x 4096 cells took longer than 2 s")) << dump(p);
+}
+
 // The image of a map_server grid is read no further than its header says: the whole file was read
 // into memory first, so that an image path naming a 2 GB file cost 20 s and 4 GB (6 GB when it
 // was no image at all). A FIFO blocked the loader for good (opened before it was checked), and a

@@ -22,6 +22,7 @@ namespace {
 // max_grid_cells, 16 Mi, at most 256 MiB of text).
 constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
 constexpr std::size_t kMaxP2BytesPerPixel = 16;
+constexpr double kDrawBudgetMs = 2000.0;  // [ms] drawing a scenario grid's obstacles (see read_scenario_grid)
 
 bool resolution_ok(double resolution) {
   return resolution >= kMinGridResolution && resolution <= kMaxGridResolution;  // false for NaN
@@ -370,7 +371,16 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
     }
   }
   if (problems.size() != before) return false;
-  raster.add_obstacles(shapes);
+  // Drawing costs the shapes' area in cells: within the limits above, 512 polygons zigzagging
+  // across 16 Mi cells still took 29 s and 640 MB. The file is refused past kDrawBudgetMs instead.
+  raster.add_obstacles(shapes, StopCondition::after_ms(kDrawBudgetMs));
+  if (raster.stopped() != StopReason::kNone) {
+    std::ostringstream os;
+    os << "grid.obstacles: drawing them on " << cw << " x " << ch << " cells took longer than "
+       << kDrawBudgetMs / 1000.0 << " s (fewer or smaller shapes, or larger cells)";
+    problems.push_back(os.str());
+    return false;
+  }
   out.resolution_m = resolution;
   out.origin = origin;
   out.width = static_cast<std::uint32_t>(cw);
