@@ -24,8 +24,9 @@ struct CliRun {
   std::string out;
 };
 
-CliRun run_cli(const std::string& arguments) {
-  const std::string command = std::string(PULLOUT_CLI_EXE) + " " + arguments + " 2>/dev/null";
+// `stderr_too`: stderr is read with stdout (for the messages of bad options), else discarded.
+CliRun run_cli(const std::string& arguments, bool stderr_too = false) {
+  const std::string command = std::string(PULLOUT_CLI_EXE) + " " + arguments + (stderr_too ? " 2>&1" : " 2>/dev/null");
   CliRun run;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
@@ -158,6 +159,32 @@ TEST(PlanSvg, SvgWholeDrawsTheWholeSceneWithoutAnInset) {
     }
   }
   EXPECT_TRUE(road);
+}
+
+// A number of seconds that is not positive is refused naming the option in plain words; CLI11's own
+// range check printed "Value 0 not in range 0.000000 to " and the 309 digits of the largest double.
+TEST(Options, ANonPositiveNumberOfSecondsIsRefusedInPlainWords) {
+  const std::string scenario = scenario_file("straight_shoulder");
+  for (const std::string& arguments :
+       {"request " + scenario + " --timeout 0", "request " + scenario + " --timeout -1",
+        "request " + scenario + " --timeout nan", "request " + scenario + " --timeout inf",
+        "request " + scenario + " --timeout 5s", std::string("watch --interval 0"), std::string("watch --duration -2"),
+        std::string("watch --once --wait inf"), std::string("view --duration 0"),
+        std::string("health http://127.0.0.1:1/ --timeout 0")}) {
+    const CliRun run = run_cli(arguments, true);
+    EXPECT_EQ(run.exit_code, 2) << arguments << ": " << run.out;
+    const std::string option = arguments.substr(arguments.rfind("--"), arguments.rfind(' ') - arguments.rfind("--"));
+    EXPECT_NE(run.out.find(option + ": must be a positive number of seconds"), std::string::npos)
+        << arguments << ": " << run.out;
+    EXPECT_EQ(run.out.find("179769"), std::string::npos) << arguments << ": " << run.out;
+  }
+}
+
+// --svg-whole only shapes the picture --svg writes: alone it is a usage error, not ignored.
+TEST(Options, SvgWholeWithoutSvgIsAUsageError) {
+  const CliRun run = run_cli("plan " + scenario_file("straight_shoulder") + " --svg-whole", true);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("--svg-whole requires --svg"), std::string::npos) << run.out;
 }
 
 }  // namespace
