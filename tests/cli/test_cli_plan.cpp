@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -159,6 +160,33 @@ TEST(PlanSvg, SvgWholeDrawsTheWholeSceneWithoutAnInset) {
     }
   }
   EXPECT_TRUE(road);
+}
+
+// `pullout plan SCENARIO --config pullout.yaml` plans like the service with that config: a route
+// without `map:` is planned on the config's map.path, as the service does (it was rejected with
+// "no Lanelet2 map is loaded by this planner: send inline lanes instead").
+TEST(PlanConfig, ARouteWithoutMapIsPlannedOnTheConfigsMap) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_cli_map_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string map = std::string(PULLOUT_SOURCE_DIR) + "/tests/maps/straight_shoulder.osm";
+  {
+    std::ofstream config(dir / "pullout.yaml");
+    config << "map: {path: " << map << "}\n";
+    std::ifstream in(scenario_file("map_shoulder"));
+    std::ofstream scenario(dir / "route_only.yaml");
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("map:", 0) != 0) scenario << line << '\n';
+    }
+  }
+  const std::string scenario = (dir / "route_only.yaml").string();
+  const CliRun with_map = run_cli("plan " + scenario + " --json --config " + (dir / "pullout.yaml").string());
+  const CliRun without = run_cli("plan " + scenario + " --json");
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(with_map.exit_code, 0) << with_map.out;
+  EXPECT_EQ(nlohmann::json::parse(with_map.out).at("planner"), "shift");
+  // Without a config (no map anywhere) it stays a rejection naming the route.
+  EXPECT_EQ(without.exit_code, 2) << without.out;
+  EXPECT_NE(without.out.find("route_lanelet_ids"), std::string::npos) << without.out;
 }
 
 // A number of seconds that is not positive is refused naming the option in plain words; CLI11's own
