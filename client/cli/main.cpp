@@ -148,6 +148,20 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   view_cmd->add_option("--duration", view.duration_s, "Stop after this many seconds")->check(kPositiveSeconds);
 
+  // CLI11 answers a misspelt command with "A subcommand is required", as if none had been given:
+  // name it. The first argument that is not an option is the command (the top level takes flags only).
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (!arg.empty() && arg[0] == '-') continue;
+    try {
+      app.get_subcommand(arg);
+    } catch (const CLI::OptionNotFound&) {
+      std::cerr << "pullout: unknown command '" << arg << "' (plan, request, watch, view, health)\n"
+                << "Run with --help for more information.\n";
+      return pullout::cli::kExitBadInput;
+    }
+    break;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -208,6 +208,15 @@ TEST(Options, ANonPositiveNumberOfSecondsIsRefusedInPlainWords) {
   }
 }
 
+// A misspelt command is named with the commands there are; CLI11 said only "A subcommand is
+// required", as if none had been given.
+TEST(Options, AnUnknownCommandIsNamed) {
+  const CliRun run = run_cli("pln " + scenario_file("straight_shoulder"), true);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("unknown command 'pln'"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("plan, request, watch, view, health"), std::string::npos) << run.out;
+}
+
 // --svg-whole only shapes the picture --svg writes: alone it is a usage error, not ignored.
 TEST(Options, SvgWholeWithoutSvgIsAUsageError) {
   const CliRun run = run_cli("plan " + scenario_file("straight_shoulder") + " --svg-whole", true);
