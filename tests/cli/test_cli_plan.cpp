@@ -189,6 +189,29 @@ TEST(PlanConfig, ARouteWithoutMapIsPlannedOnTheConfigsMap) {
   EXPECT_NE(without.out.find("route_lanelet_ids"), std::string::npos) << without.out;
 }
 
+// A rejected request has no path (report.hpp): `pullout plan` printed the session's empty one as
+// "start pose: x 0.000 m  y 0.000 m" and the error a second time under "reasons:", unlike
+// `pullout request` for the same answer.
+TEST(PlanText, ARejectedRequestPrintsTheErrorOnceAndNoPose) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_cli_rejected_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ifstream in(scenario_file("straight_shoulder"));
+    std::ofstream scenario(dir / "tram.yaml");
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("expect:", 0) != 0) scenario << line << '\n';
+    }
+    scenario << "vehicle: {profile: tram}\n";
+  }
+  const CliRun run = run_cli("plan " + (dir / "tram.yaml").string());
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  const std::string error = "vehicle_profile: unknown profile 'tram'";
+  ASSERT_NE(run.out.find(error), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find(error, run.out.find(error) + 1), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("start pose:"), std::string::npos) << run.out;
+}
+
 // A number of seconds that is not positive is refused naming the option in plain words; CLI11's own
 // range check printed "Value 0 not in range 0.000000 to " and the 309 digits of the largest double.
 TEST(Options, ANonPositiveNumberOfSecondsIsRefusedInPlainWords) {
