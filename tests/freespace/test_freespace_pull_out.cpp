@@ -357,21 +357,6 @@ TEST(FreespacePullOut, GridOnlyRequestsNeedTheFreespacePlanner) {
   EXPECT_EQ(r.issues[0].field, "lanes");
 }
 
-// A pure freespace request whose start is occupied says so, and with which margin: the row read
-// "start_invalid: to the goal" (the search's own status dropped), which left a user of
-// `pullout request freespace_parking_lot.yaml` (the service's 1.0 m margin) without a clue.
-TEST(FreespacePullOut, GridOnlyStartOccupiedNamesTheStatusAndTheMargin) {
-  Scenario sc = load("freespace_parking_lot");
-  sc.parameters.freespace_planner.vehicle_shape_margin = 1.0;  // the shipped config's: the bay is too narrow
-  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
-  EXPECT_EQ(r.outcome, PlanningResult::Outcome::kNoPath);
-  ASSERT_EQ(r.evaluation_table.size(), 1u);
-  EXPECT_EQ(r.evaluation_table[0].outcome, AttemptOutcome::kStartInvalid);
-  EXPECT_NE(r.evaluation_table[0].detail.find("start occupied"), std::string::npos) << r.evaluation_table[0].detail;
-  EXPECT_NE(r.stop_reason.find("start occupied"), std::string::npos) << r.stop_reason;
-  EXPECT_NE(r.stop_reason.find("freespace_planner.vehicle_shape_margin 1.00 m"), std::string::npos) << r.stop_reason;
-}
-
 // The freespace fallback from a backward start candidate (start_planner.hpp): the end poses of the
 // current pose lie in road works, those of a candidate behind it do not.
 TEST(FreespacePullOut, FallbackPlansFromABackwardStartCandidateWhenTheCurrentPoseFails) {

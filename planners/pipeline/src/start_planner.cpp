@@ -385,15 +385,8 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
     r = plan_freespace_to_goal(costmap, vehicle, p, request.ego_pose, request.goal_pose, stop, &plan_rrt_star);
   }
   const double margin = 0.5 * p.vehicle_shape_margin;
-  // The search's own status, and for an occupied start or goal the margin that makes it so (the
-  // knob a user turns): "to the goal" alone left the reason out.
-  std::string detail = std::string("to the goal: ") + to_string(r.status);
-  if (r.status == HybridAStarResult::Status::kStartOccupied || r.status == HybridAStarResult::Status::kGoalOccupied) {
-    detail += " (the vehicle grown by freespace_planner.vehicle_shape_margin " +
-              format_fixed(p.vehicle_shape_margin, 2) + " m)";
-  }
   const Failure f =
-      r.stopped != StopReason::kNone ? stopped_failure(r.stopped) : Failure{attempt_outcome(r.status), detail};
+      r.stopped != StopReason::kNone ? stopped_failure(r.stopped) : Failure{attempt_outcome(r.status), "to the goal"};
   result.evaluation_table.push_back({PlannerType::kFreespace, margin, 0.0, f.outcome, f.detail});
   if (r.status == HybridAStarResult::Status::kSuccess) {
     result.outcome = PlanningResult::Outcome::kFound;
@@ -406,7 +399,7 @@ PlanningResult StartPlanner::plan_grid_only(const PullOutRequest& request, const
   result.timed_out = result.stopped == StopReason::kDeadline;
   result.outcome = PlanningResult::Outcome::kNoPath;
   result.path = make_stop_path(request);
-  result.stop_reason = "freespace: " + describe(result.evaluation_table.back());
+  result.stop_reason = "freespace to the goal: " + describe(result.evaluation_table.back());
   result.path.reasons.push_back(result.stop_reason);
   return result;
 }
