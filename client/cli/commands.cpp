@@ -14,6 +14,7 @@
 #include "pullout/config/config.hpp"
 #include "pullout/config/scenario.hpp"
 #include "pullout/maps/lanelet_map.hpp"
+#include "pullout/maps/osm_loader.hpp"
 #include "pullout/model/names.hpp"
 #include "pullout/pipeline/parameters.hpp"
 #include "pullout/pipeline/start_planner.hpp"
@@ -132,6 +133,17 @@ int run_plan(const PlanOptions& options, std::ostream& out, std::ostream& err) {
   } catch (const ConfigError& e) {
     err << "pullout: " << e.what() << '\n';
     return kExitBadInput;
+  }
+  // A scenario without `map:` is planned on the config's map.path, as the service with that
+  // config plans it (its route ids refer to that map).
+  if (!scenario.map && !config.map.path.empty()) {
+    try {
+      scenario.map = load_lanelet_map(config.map.path);
+      scenario.map_path = config.map.path;
+    } catch (const MapLoadError& e) {
+      err << "pullout: " << options.config_file << ": map.path: " << e.what() << '\n';
+      return kExitBadInput;
+    }
   }
   // load_config and load_scenario have checked every parameter (ConfigError above).
   note_fleet_not_used(scenario, "planned here", err);

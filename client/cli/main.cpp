@@ -1,4 +1,6 @@
 // pullout: plan a pull-out in-process, or ask a running pullout service over DDS.
+#include <cmath>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <string>
@@ -26,6 +28,20 @@ constexpr const char* kExitCodes =
     "watch: 0 stopped (--duration, --once, interrupt), 3 DDS setup failed or --once found no service\n"
     "health: 0 the URL answered 200, 1 another HTTP status, 2 bad URL, 3 no answer (refused, timeout)\n";
 
+// The options that take seconds. CLI::PositiveNumber would print its range, "0.000000 to " and the
+// 309 digits of the largest double, for 0; this says what is meant. Infinity and NaN are refused
+// too: a run that waits forever is asked for by leaving --duration out.
+const CLI::Validator kPositiveSeconds(
+    [](std::string& value) -> std::string {
+      char* end = nullptr;
+      const double v = std::strtod(value.c_str(), &end);
+      if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(v) || !(v > 0.0)) {
+        return "must be a positive number of seconds, got '" + value + "'";
+      }
+      return {};
+    },
+    "SECONDS > 0");
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -38,10 +54,10 @@ int main(int argc, char** argv) {
   CLI::App* plan_cmd = app.add_subcommand("plan", "Plan in-process with the service's pipeline");
   plan_cmd->add_option("scenario", plan.scenario_file, "Scenario file (YAML)")->required()->check(CLI::ExistingFile);
   plan_cmd->add_flag("--json", plan.output.json, "Print one JSON object instead of text");
-  plan_cmd->add_option("--svg", plan.output.svg_file,
-                       "Also draw the scenario and path into this SVG file (framed on the manoeuvre, the whole "
-                       "scene in an inset)");
-  plan_cmd->add_flag("--svg-whole", plan.output.svg_whole, "The SVG shows the whole scene, no inset");
+  CLI::Option* plan_svg = plan_cmd->add_option("--svg", plan.output.svg_file,
+                                               "Also draw the scenario and path into this SVG file (framed on the "
+                                               "manoeuvre, the whole scene in an inset)");
+  plan_cmd->add_flag("--svg-whole", plan.output.svg_whole, "The SVG shows the whole scene, no inset")->needs(plan_svg);
   plan_cmd->add_option("--config", plan.config_file, "pullout.yaml to start from (default: built-in defaults)")
       ->check(CLI::ExistingFile);
 
@@ -56,10 +72,11 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   request_cmd->add_flag("--json", request.output.json, "Print one JSON object instead of text");
-  request_cmd->add_option("--svg", request.output.svg_file,
-                          "Also draw the scenario and path into this SVG file (framed on the manoeuvre, the whole "
-                          "scene in an inset)");
-  request_cmd->add_flag("--svg-whole", request.output.svg_whole, "The SVG shows the whole scene, no inset");
+  CLI::Option* request_svg = request_cmd->add_option("--svg", request.output.svg_file,
+                                                     "Also draw the scenario and path into this SVG file (framed on "
+                                                     "the manoeuvre, the whole scene in an inset)");
+  request_cmd->add_flag("--svg-whole", request.output.svg_whole, "The SVG shows the whole scene, no inset")
+      ->needs(request_svg);
   request_cmd->add_option("--domain", request.domain_id, "DDS domain id")
       ->capture_default_str()
       ->check(CLI::Range(0, 232));
@@ -73,7 +90,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   request_cmd->add_option("--timeout", request.timeout_s, "Seconds to wait for the service and its answer")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveSeconds);
 
   pullout::cli::HealthOptions health;
   CLI::App* health_cmd = app.add_subcommand(
@@ -83,7 +100,7 @@ int main(int argc, char** argv) {
   health_cmd->add_option("url", health.url, "http://host:port/path")->required();
   health_cmd->add_option("--timeout", health.timeout_s, "Seconds for connecting and the answer")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveSeconds);
   health_cmd->add_flag("-q,--quiet", health.quiet, "Print nothing on success");
 
   pullout::cli::WatchOptions watch;
@@ -98,16 +115,16 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   watch_cmd->add_option("--interval", watch.interval_s, "Seconds between tables")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveSeconds);
   CLI::Option* duration_opt =
-      watch_cmd->add_option("--duration", watch.duration_s, "Stop after this many seconds")->check(CLI::PositiveNumber);
+      watch_cmd->add_option("--duration", watch.duration_s, "Stop after this many seconds")->check(kPositiveSeconds);
   watch_cmd
       ->add_flag("--once", watch.once,
                  "Print one table once the service's samples have arrived (at most --wait seconds), then exit")
       ->excludes(duration_opt);
   watch_cmd->add_option("--wait", watch.wait_s, "--once: seconds to wait for the service")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveSeconds);
 
   pullout::cli::ViewOptions view;
   CLI::App* view_cmd = app.add_subcommand(
@@ -129,8 +146,22 @@ int main(int argc, char** argv) {
       ->add_option("--config", view.config_file,
                    "pullout.yaml of the service: its vehicle is the footprint drawn, its dds section the defaults")
       ->check(CLI::ExistingFile);
-  view_cmd->add_option("--duration", view.duration_s, "Stop after this many seconds")->check(CLI::PositiveNumber);
+  view_cmd->add_option("--duration", view.duration_s, "Stop after this many seconds")->check(kPositiveSeconds);
 
+  // CLI11 answers a misspelt command with "A subcommand is required", as if none had been given:
+  // name it. The first argument that is not an option is the command (the top level takes flags only).
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (!arg.empty() && arg[0] == '-') continue;
+    try {
+      app.get_subcommand(arg);
+    } catch (const CLI::OptionNotFound&) {
+      std::cerr << "pullout: unknown command '" << arg << "' (plan, request, watch, view, health)\n"
+                << "Run with --help for more information.\n";
+      return pullout::cli::kExitBadInput;
+    }
+    break;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

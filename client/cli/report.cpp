@@ -98,7 +98,10 @@ PlanReport make_report(const std::optional<PullOutPath>& path, const PullOutStat
   report.stop_reason = status.stop_reason;
   report.turn_signal = status.turn_signal;
   report.safe = status.safe;
-  if (path) {
+  // A rejected request has no path: the service's reply to one is empty (its poses 0) and repeats
+  // the error as reasons, which `pullout request` never waits for; `pullout plan` gets it from the
+  // session and printed both.
+  if (path && status.state != ExecutionState::kRejected) {
     report.path = path;
     report.found = path->found && has_path(status.state);
     if (path->planner_type != PlannerType::kNone) report.planner = path->planner_type;

@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 
@@ -204,7 +205,15 @@ int main(int argc, char** argv) {
     if (arg == "--approve") {
       options.approve = true;
     } else if (arg == "--domain" && has_value) {
-      options.domain_id = std::atoi(argv[++i]);
+      // Strictly a whole number: atoi made "abc" domain 0, where another fleet's service may be.
+      const std::string value = argv[++i];
+      char* end = nullptr;
+      const long domain = std::strtol(value.c_str(), &end, 10);
+      if (value.empty() || end != value.c_str() + value.size() || domain < 0 || domain > 232) {
+        std::cerr << "--domain: expected a DDS domain id in 0..232, got '" << value << "'\n";
+        return 2;
+      }
+      options.domain_id = static_cast<int>(domain);
     } else if (arg == "--vehicle" && has_value) {
       options.vehicle_id = argv[++i];
     } else if (arg == "--profiles" && has_value) {
@@ -216,6 +225,9 @@ int main(int argc, char** argv) {
   }
   try {
     return run(options);
+  } catch (const std::invalid_argument& e) {  // a ClientOptions field the client refuses: a bad argument
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << '\n';
     return 3;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,8 +25,9 @@ struct CliRun {
   std::string out;
 };
 
-CliRun run_cli(const std::string& arguments) {
-  const std::string command = std::string(PULLOUT_CLI_EXE) + " " + arguments + " 2>/dev/null";
+// `stderr_too`: stderr is read with stdout (for the messages of bad options), else discarded.
+CliRun run_cli(const std::string& arguments, bool stderr_too = false) {
+  const std::string command = std::string(PULLOUT_CLI_EXE) + " " + arguments + (stderr_too ? " 2>&1" : " 2>/dev/null");
   CliRun run;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
@@ -158,6 +160,91 @@ TEST(PlanSvg, SvgWholeDrawsTheWholeSceneWithoutAnInset) {
     }
   }
   EXPECT_TRUE(road);
+}
+
+// `pullout plan SCENARIO --config pullout.yaml` plans like the service with that config: a route
+// without `map:` is planned on the config's map.path, as the service does (it was rejected with
+// "no Lanelet2 map is loaded by this planner: send inline lanes instead").
+TEST(PlanConfig, ARouteWithoutMapIsPlannedOnTheConfigsMap) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_cli_map_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string map = std::string(PULLOUT_SOURCE_DIR) + "/tests/maps/straight_shoulder.osm";
+  {
+    std::ofstream config(dir / "pullout.yaml");
+    config << "map: {path: " << map << "}\n";
+    std::ifstream in(scenario_file("map_shoulder"));
+    std::ofstream scenario(dir / "route_only.yaml");
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("map:", 0) != 0) scenario << line << '\n';
+    }
+  }
+  const std::string scenario = (dir / "route_only.yaml").string();
+  const CliRun with_map = run_cli("plan " + scenario + " --json --config " + (dir / "pullout.yaml").string());
+  const CliRun without = run_cli("plan " + scenario + " --json");
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(with_map.exit_code, 0) << with_map.out;
+  EXPECT_EQ(nlohmann::json::parse(with_map.out).at("planner"), "shift");
+  // Without a config (no map anywhere) it stays a rejection naming the route.
+  EXPECT_EQ(without.exit_code, 2) << without.out;
+  EXPECT_NE(without.out.find("route_lanelet_ids"), std::string::npos) << without.out;
+}
+
+// A rejected request has no path (report.hpp): `pullout plan` printed the session's empty one as
+// "start pose: x 0.000 m  y 0.000 m" and the error a second time under "reasons:", unlike
+// `pullout request` for the same answer.
+TEST(PlanText, ARejectedRequestPrintsTheErrorOnceAndNoPose) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pullout_test_cli_rejected_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ifstream in(scenario_file("straight_shoulder"));
+    std::ofstream scenario(dir / "tram.yaml");
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("expect:", 0) != 0) scenario << line << '\n';
+    }
+    scenario << "vehicle: {profile: tram}\n";
+  }
+  const CliRun run = run_cli("plan " + (dir / "tram.yaml").string());
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  const std::string error = "vehicle_profile: unknown profile 'tram'";
+  ASSERT_NE(run.out.find(error), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find(error, run.out.find(error) + 1), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("start pose:"), std::string::npos) << run.out;
+}
+
+// A number of seconds that is not positive is refused naming the option in plain words; CLI11's own
+// range check printed "Value 0 not in range 0.000000 to " and the 309 digits of the largest double.
+TEST(Options, ANonPositiveNumberOfSecondsIsRefusedInPlainWords) {
+  const std::string scenario = scenario_file("straight_shoulder");
+  for (const std::string& arguments :
+       {"request " + scenario + " --timeout 0", "request " + scenario + " --timeout -1",
+        "request " + scenario + " --timeout nan", "request " + scenario + " --timeout inf",
+        "request " + scenario + " --timeout 5s", std::string("watch --interval 0"), std::string("watch --duration -2"),
+        std::string("watch --once --wait inf"), std::string("view --duration 0"),
+        std::string("health http://127.0.0.1:1/ --timeout 0")}) {
+    const CliRun run = run_cli(arguments, true);
+    EXPECT_EQ(run.exit_code, 2) << arguments << ": " << run.out;
+    const std::string option = arguments.substr(arguments.rfind("--"), arguments.rfind(' ') - arguments.rfind("--"));
+    EXPECT_NE(run.out.find(option + ": must be a positive number of seconds"), std::string::npos)
+        << arguments << ": " << run.out;
+    EXPECT_EQ(run.out.find("179769"), std::string::npos) << arguments << ": " << run.out;
+  }
+}
+
+// A misspelt command is named with the commands there are; CLI11 said only "A subcommand is
+// required", as if none had been given.
+TEST(Options, AnUnknownCommandIsNamed) {
+  const CliRun run = run_cli("pln " + scenario_file("straight_shoulder"), true);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("unknown command 'pln'"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("plan, request, watch, view, health"), std::string::npos) << run.out;
+}
+
+// --svg-whole only shapes the picture --svg writes: alone it is a usage error, not ignored.
+TEST(Options, SvgWholeWithoutSvgIsAUsageError) {
+  const CliRun run = run_cli("plan " + scenario_file("straight_shoulder") + " --svg-whole", true);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("--svg-whole requires --svg"), std::string::npos) << run.out;
 }
 
 }  // namespace

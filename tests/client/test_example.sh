@@ -48,6 +48,17 @@ grep -q "DDS profiles in $prefix/share/pullout/dds" "$work/configure.log" \
 "$cmake_bin" --build "$work/build" >"$work/build.log" 2>&1 || { cat "$work/build.log" >&2; fail "example build"; }
 example=$work/build/pullout_vehicle_client
 
+# Bad arguments are exit status 2 at once, before any DDS: a domain that is no number must not
+# become domain 0 (atoi did that, and the example then waited 15 s for a service there).
+for bad in "--domain abc" "--domain 5x" "--domain 999" "--domain -1" "--vehicle ''" "--domain"; do
+  status=0
+  eval timeout 10 "$example" "$bad" >"$work/bad.out" 2>&1 || status=$?
+  [ "$status" -eq 2 ] || { cat "$work/bad.out" >&2; fail "'$bad' exited with $status (expected 2)"; }
+  case "$bad" in
+    "--domain "?*) grep -q -- "--domain" "$work/bad.out" || { cat "$work/bad.out" >&2; fail "'$bad': --domain not named"; } ;;
+  esac
+done
+
 # A DDS domain of our own (the lock is released when this shell exits).
 domain=""
 for i in $(seq 0 98); do

@@ -463,7 +463,11 @@ void DdsEdge::create_entities(const DdsConfig& config, const ReplicaConfig& repl
     discovery.leaseDuration_announcementperiod =
         eprosima::fastrtps::Duration_t(announce / 1000, static_cast<std::uint32_t>(announce % 1000) * 1'000'000);
   }
-  if (qos.name().to_string().empty() || qos.name().to_string() == "RTPSParticipant") {
+  // Other services name this one by its participant name when they see it on the domain: a name
+  // left unset, Fast DDS's default or the one every shipped profile gives every participant
+  // ("pullout", clients too) would name no process, so the service names itself by host and pid.
+  const std::string profile_name = qos.name().to_string();
+  if (profile_name.empty() || profile_name == "RTPSParticipant" || profile_name == "pullout") {
     char host[256] = {};
     if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
     qos.name(("pullout_service@" + std::string(host) + " pid " + std::to_string(getpid())).substr(0, 255));
