@@ -4,8 +4,11 @@
 // load_scenario reads a file, so each input is written to <temp>/scenarios/input.yaml. The temp
 // directory also holds what the project's scenarios refer to: maps/ (a link to tests/maps, for
 // `map: ../maps/straight_shoulder.osm`) and a small ROS map_server grid, scenarios/lot.yaml and
-// lot.pgm (for `grid: {map: lot.yaml}`). A ConfigError is the expected answer to a bad file;
-// anything else escaping, a crash or a sanitizer report is a defect.
+// lot.pgm (for `grid: {map: lot.yaml}`). An input that begins as a PGM image does ("P2" or "P5")
+// is the image instead: written to scenarios/input.pgm and read through a fixed scenario whose
+// grid is the map_server file image.yaml naming it (the PGM reader gets the fuzzed bytes). A
+// ConfigError is the expected answer to a bad file; anything else escaping, a crash or a sanitizer
+// report is a defect.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -34,7 +37,13 @@ struct Fixture {
         << std::string("\xff\xff\xff\x00", 4);
     std::ofstream(dir / "scenarios" / "lot.yaml") << "image: lot.pgm\nresolution: 0.5\norigin: [1.0, 2.0, 0.0]\n"
                                                   << "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n";
+    std::ofstream(dir / "scenarios" / "image.yaml") << "image: input.pgm\nresolution: 0.5\norigin: [0.0, 0.0, 0.0]\n"
+                                                    << "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n";
+    std::ofstream(dir / "scenarios" / "image_scenario.yaml")
+        << "start: {x: 1.0, y: 1.0, yaw: 0.0}\ngoal: {x: 2.0, y: 1.0, yaw: 0.0}\ngrid: {map: image.yaml}\n";
     input = (dir / "scenarios" / "input.yaml").string();
+    image = (dir / "scenarios" / "input.pgm").string();
+    image_scenario = (dir / "scenarios" / "image_scenario.yaml").string();
   }
   ~Fixture() {
     std::error_code ignored;
@@ -46,6 +55,8 @@ struct Fixture {
   pullout::Config base;
   fs::path dir;
   std::string input;
+  std::string image;
+  std::string image_scenario;
 };
 
 Fixture& fixture() {
@@ -63,12 +74,13 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   Fixture& f = fixture();
+  const bool pgm = size >= 2 && data[0] == 'P' && (data[1] == '2' || data[1] == '5');
   {
-    std::ofstream out(f.input, std::ios::binary | std::ios::trunc);
+    std::ofstream out(pgm ? f.image : f.input, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   }
   try {
-    const pullout::Scenario scenario = pullout::load_scenario(f.input, f.base);
+    const pullout::Scenario scenario = pullout::load_scenario(pgm ? f.image_scenario : f.input, f.base);
   } catch (const pullout::ConfigError&) {
     // the expected answer to a bad file
   }
