@@ -161,6 +161,50 @@ TEST(StartPlanner, BoxedInGivesAStopPathWithEveryAttemptsReason) {
   EXPECT_FALSE(r.stop_reason.empty());
 }
 
+// The largest heading change [rad] between consecutive points of a path, per metre between them:
+// a path a car can drive turns no faster than 1 / its full-steer radius.
+double sharpest_turn(const PullOutPath& path) {
+  double sharpest = 0.0;
+  for (const PathWithLaneId& seg : path.partial_paths) {
+    for (std::size_t i = 1; i < seg.points.size(); ++i) {
+      const Pose2& a = seg.points[i - 1].pose;
+      const Pose2& b = seg.points[i].pose;
+      const double d = std::hypot(b.x - a.x, b.y - a.y);
+      if (d > 1e-6) sharpest = std::max(sharpest, std::abs(normalize_angle(b.yaw - a.yaw)) / d);
+    }
+  }
+  return sharpest;
+}
+
+// A vehicle standing across its lane (80 degrees off it) got a reverse "along the lane" to a start
+// candidate behind it: its heading jumped 80 degrees within the first metre, a path no car can
+// drive. The candidates behind are skipped then, saying why; a vehicle 10 degrees off keeps them.
+TEST(StartPlanner, AVehicleAcrossItsLaneGetsNoReverseItCannotDrive) {
+  const VehicleInfo vehicle;
+  const double full_steer_curvature = std::tan(vehicle.max_steer_angle_rad) / vehicle.wheel_base_m;
+  for (const double yaw_deg : {-80.0, -45.0, 90.0}) {
+    auto req = test::straight_shoulder_request();
+    req.ego_pose.yaw = yaw_deg * kDegToRad;
+    const PlanningResult r = default_planner().plan(req, StopCondition());
+    if (r.outcome == PlanningResult::Outcome::kFound) {
+      EXPECT_LE(sharpest_turn(r.path), full_steer_curvature * 1.001) << yaw_deg << " deg: " << r.stop_reason;
+    }
+    bool skipped = false;
+    for (const PlannerAttempt& a : r.evaluation_table) {
+      skipped = skipped || a.detail.find("start candidates behind skipped: the vehicle's heading deviates") == 0;
+    }
+    EXPECT_TRUE(skipped) << yaw_deg;
+  }
+  auto aligned = test::straight_shoulder_request();
+  aligned.ego_pose.yaw = -10.0 * kDegToRad;
+  const PlanningResult r = default_planner().plan(aligned, StopCondition());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  EXPECT_LE(sharpest_turn(r.path), full_steer_curvature * 1.001);
+  for (const PlannerAttempt& a : r.evaluation_table) {
+    EXPECT_EQ(a.detail.find("start candidates behind skipped"), std::string::npos) << a.detail;
+  }
+}
+
 TEST(StartPlanner, MovingObjectsAreNotStaticObstacles) {
   auto req = test::straight_shoulder_request();
   Object passing = test::parked_car(7, 16.5, 3.25);

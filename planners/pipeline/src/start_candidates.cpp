@@ -54,6 +54,22 @@ StartCandidateSearch search_start_candidates(const PlanningContext& ctx, const S
   // pose first); the checks below pick the poses worth reversing to.
   out.candidates.push_back({ego, 0.0});
   const std::string what = "start candidate";
+  // The reverse to a candidate runs along the lanes from the vehicle's own heading: the vehicle
+  // must turn its deviation from them out within the reverse's first step at full steer, or the
+  // path is one it cannot drive (standing across the lane it would reverse sideways: 80 degrees
+  // within a metre). Beyond that, no candidate behind it.
+  const double lane_yaw = lanes.centerline.yaw_at(at.s) + (at.facing > 0.0 ? 0.0 : kPi);
+  const double deviation = normalize_angle(ego.yaw - lane_yaw);
+  const double full_steer_radius = ctx.vehicle.wheel_base_m / std::tan(ctx.vehicle.max_steer_angle_rad);
+  const double turnable = p.center_line_path_interval / full_steer_radius;  // [rad] in the first step
+  if (allowed > kMinCandidateSpacing && std::abs(deviation) > turnable) {
+    out.skipped.push_back({std::min(p.backward_search_resolution, allowed),
+                           what + "s behind skipped: the vehicle's heading deviates " +
+                               format_fixed(deviation * kRadToDeg, 1) + " deg from the lanes; reversing along them, " +
+                               "it turns at most " + format_fixed(turnable * kRadToDeg, 1) + " deg in the first " +
+                               format_fixed(p.center_line_path_interval, 2) + " m at full steer"});
+    return out;
+  }
   // Whether a pose `back` behind keeps the smallest margin to every obstacle.
   const auto clear_at = [&](double back) {
     return ctx.objects.clearance(backed_pose(lanes, at, back), last_margin).distance >= last_margin;
