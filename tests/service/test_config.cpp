@@ -197,6 +197,21 @@ TEST(ConfigTable, CheckConfigNamesEveryBadMember) {
   EXPECT_EQ(p.size(), 8u) << dump(p);
 }
 
+// The margins are tried largest first and the last is the least the backward search keeps: a
+// list out of order is refused, naming the first entry out of place.
+TEST(ConfigTable, CollisionCheckMarginsMustDecrease) {
+  Config c;
+  c.start_planner.collision_check_margins = {2.0, 0.5, 1.0};
+  auto p = check_config(c);
+  ASSERT_EQ(p.size(), 1u) << dump(p);
+  EXPECT_EQ(p[0],
+            "start_planner.collision_check_margins[2]: must be below the one before (0.5; tried largest first), got 1");
+  c.start_planner.collision_check_margins = {1.0, 1.0};
+  EXPECT_EQ(check_config(c).size(), 1u);
+  c.start_planner.collision_check_margins = {2.0, 1.0, 0.5, 0.1};
+  EXPECT_TRUE(check_config(c).empty());
+}
+
 TEST(ConfigTable, OutOfRangeValueInAFileCarriesItsLine) {
   const auto p = problems_of(std::string(kMinimal) + "start_planner:\n  lateral_jerk: 0.4\n  max_back_distance: 500\n");
   ASSERT_EQ(p.size(), 1u) << dump(p);

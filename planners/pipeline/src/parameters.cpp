@@ -50,6 +50,18 @@ std::vector<ParameterIssue> validate_parameters(const StartPlannerParameters& p)
     fail("maximum_lateral_acc",
          "must be >= minimum_lateral_acc (" + text(p.minimum_lateral_acc) + "), got " + text(p.maximum_lateral_acc));
   }
+  // Tried in turn, the largest first (the first margin a path keeps wins), and the last is the
+  // least the backward search keeps: an unsorted list tried a small margin first and backed up
+  // to the wrong one.
+  for (std::size_t i = 1; i < p.collision_check_margins.size(); ++i) {
+    const double before = p.collision_check_margins[i - 1];
+    const double margin = p.collision_check_margins[i];
+    if (std::isfinite(before) && std::isfinite(margin) && !(margin < before)) {
+      fail("collision_check_margins[" + std::to_string(i) + "]",
+           "must be below the one before (" + text(before) + "; tried largest first), got " + text(margin));
+      break;
+    }
+  }
   const FreespaceParameters& f = p.freespace_planner;
   if (std::isfinite(f.end_pose_search_start_distance) && std::isfinite(f.end_pose_search_end_distance) &&
       f.end_pose_search_end_distance < f.end_pose_search_start_distance) {

@@ -293,7 +293,7 @@ const Table<StartPlannerParameters>& start_planner_table() {
 
           note<P>("--- search ---", true),
           field("collision_check_margins", &P::collision_check_margins, "m", NumberList{1, 16, in(0.0, 10.0)},
-                "clearance to static objects, tried in order"),
+                "clearance to static objects, tried in order, decreasing"),
           note<P>("Planners, in order (upper case as in Autoware, or lower case). FREESPACE here runs the\n"
                   "hybrid A* in that place of the order (from the current pose, over the margin ladder);\n"
                   "freespace_planner.enable_freespace_planner below runs it as the fallback when nothing\n"
