@@ -176,6 +176,21 @@ TEST(Scenario, PlannerKeysARequestDoesNotCarryAreListed) {
   EXPECT_TRUE(load_scenario(carried.path()).local_planner_keys.empty());
 }
 
+// Headings are read into [-pi, pi], as a request's quaternion carries them: 1e10 degrees was
+// planned and echoed as 174532925 rad.
+TEST(Scenario, HeadingsAreNormalised) {
+  ScenarioFile file(std::string(kLanes) + "start: {x: 10.0, y: 3.5, yaw_deg: 370}\n" +
+                    "goal: {x: 90.0, y: 0.0, yaw: -7.0}\n" +
+                    "objects:\n  - {id: 7, class: car, x: 20.0, y: 3.5, yaw_deg: 1e10, length: 4.0, width: 1.8}\n");
+  const Scenario s = load_scenario(file.path());
+  EXPECT_NEAR(s.request.ego_pose.yaw, 10.0 * kDegToRad, 1e-12);
+  EXPECT_NEAR(s.request.goal_pose.yaw, -7.0 + 2.0 * kPi, 1e-12);
+  const double object_yaw = s.request.objects.at(0).pose.yaw;
+  EXPECT_GE(object_yaw, -kPi);
+  EXPECT_LE(object_yaw, kPi);
+  EXPECT_NEAR(std::remainder(object_yaw - 1e10 * kDegToRad, 2.0 * kPi), 0.0, 1e-6);
+}
+
 TEST(Scenario, VehicleIdDefaultsToTheFileName) {
   ScenarioFile file(std::string(kLanes) + kPoses);
   const Scenario s = load_scenario(file.path());

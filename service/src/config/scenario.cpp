@@ -67,8 +67,10 @@ double read_yaw(MapReader& r) {
   if (r.has("yaw") && r.has("yaw_deg")) {
     r.problems().push_back(r.key_path("yaw_deg") + ": give either yaw [rad] or yaw_deg, not both");
   }
-  if (has_deg) return yaw_deg * kDegToRad;
-  return has_rad ? yaw : 0.0;
+  const double value = has_deg ? yaw_deg * kDegToRad : (has_rad ? yaw : 0.0);
+  // Within [-pi, pi], as a request's quaternion gives it (yaw_deg: 1e10 was echoed as 174532925
+  // rad); NaN and infinity are left for the request's validation to name.
+  return std::isfinite(value) && std::abs(value) > kPi ? normalize_angle(value) : value;
 }
 
 // {x, y, yaw | yaw_deg}
