@@ -121,6 +121,17 @@ TEST(BoundedWork, CoordinatesBeyondTheLimitAreRejectedNamingTheField) {
   EXPECT_FALSE(planner().validate(req).empty());
 }
 
+// A bound too short to give a direction is named with its limit in plain figures (it read
+// "shorter than 0.100000 m").
+TEST(BoundedWork, ADegenerateBoundIsNamedWithItsLimit) {
+  PullOutRequest req = test::straight_shoulder_request();
+  req.lanes[0].left_bound = {{0.0, 1.75}, {0.05, 1.75}};
+  const auto issues = planner().validate(req);
+  ASSERT_EQ(issues.size(), 1U) << format_issues(issues);
+  EXPECT_EQ(issues[0].field, "lanes[0].left_bound");
+  EXPECT_EQ(issues[0].problem, "degenerate: shorter than 0.1 m");
+}
+
 TEST(BoundedWork, SpeedsBeyondTheLimitAreRejectedNamingTheField) {
   // A fuzzed request (fuzz/corpus/request/regress_stop_profile_speed_oom.cdr) with an ego speed of
   // 2e236 m/s was planned, and the safety check at the start then built its stop profile until it

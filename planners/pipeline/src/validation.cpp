@@ -105,7 +105,9 @@ void validate_lane(Checker& c, const std::string& f, const Lane& lane) {
     } else if (!c.points(lf, *line)) {
       ok = false;
     } else if (polyline_length(*line) < kMinBoundLength) {
-      c.add(lf, "degenerate: shorter than " + std::to_string(kMinBoundLength) + " m");
+      std::ostringstream os;
+      os << "degenerate: shorter than " << kMinBoundLength << " m";  // 0.1, not to_string's 0.100000
+      c.add(lf, os.str());
       ok = false;
     }
   }
