@@ -223,6 +223,18 @@ TEST(FreespacePullOut, UnknownAlgorithmIsNamedByTheCoreValidation) {
   EXPECT_NE(issues[0].problem.find("'bitstar'"), std::string::npos) << issues[0].problem;
 }
 
+// A grid-only request grows the vehicle by the shape margin where the start allows it, as one
+// with lanes does (the header): at Autoware's default of 1.0 m the car nose-in in its bay of the
+// lot was "start occupied" (the full margin reached the cars beside it), and is planned out now.
+TEST(FreespacePullOut, AGridOnlyStartInABayKeepsTheMarginItHasRoomFor) {
+  Scenario sc = load("freespace_parking_lot");
+  sc.parameters.freespace_planner.vehicle_shape_margin = 1.0;
+  sc.request.goal_pose = {25.0, 26.0, 0.0};  // clear of the east edge with the full margin
+  const PlanningResult r = StartPlanner(sc.vehicle, sc.parameters).plan(sc.request, StopCondition());
+  ASSERT_EQ(r.outcome, PlanningResult::Outcome::kFound) << r.stop_reason;
+  EXPECT_EQ(r.path.planner_type, PlannerType::kFreespace);
+}
+
 TEST(FreespacePullOut, LanePlannersAloneCannotLeaveTheBoxedInSpot) {
   Scenario sc = load("freespace_boxed_in");
   sc.parameters.freespace_planner.enable_freespace_planner = false;

@@ -237,7 +237,9 @@ FreespaceGoalResult plan_freespace_to_goal(const Costmap& costmap, const Vehicle
                                            const FreespaceParameters& p, const Pose2& start, const Pose2& goal,
                                            const StopCondition& stop, const FreespaceSearch& rrt_star) {
   FreespaceGoalResult out;
-  const GridCollisionChecker checker(costmap, freespace_footprint(vehicle, p));
+  // The margin where the start allows it, as from a lane (see the header): the full margin put a
+  // car parked in a bay of a grid in collision at Autoware's default of 1.0 m.
+  const GridCollisionChecker checker(costmap, freespace_footprint(vehicle, p, costmap, start));
   HybridAStarConfig config = freespace_search_config(vehicle, p);
   const HybridAStarResult r =
       freespace_search(p, rrt_star)(checker, config, start, goal, stop.with_budget_ms(p.time_limit));
