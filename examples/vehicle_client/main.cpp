@@ -202,6 +202,10 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
+    if (arg == "-h" || arg == "--help") {
+      std::cout << "usage: pullout_vehicle_client [--domain N] [--vehicle ID] [--profiles FILE.xml] [--approve]\n";
+      return 0;
+    }
     if (arg == "--approve") {
       options.approve = true;
     } else if (arg == "--domain" && has_value) {

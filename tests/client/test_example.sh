@@ -59,6 +59,10 @@ for bad in "--domain abc" "--domain 5x" "--domain 999" "--domain -1" "--vehicle 
   esac
 done
 
+# --help prints the usage on stdout and is no error.
+timeout 10 "$example" --help >"$work/help.out" 2>&1 || { cat "$work/help.out" >&2; fail "--help exited with an error"; }
+grep -q "^usage: pullout_vehicle_client" "$work/help.out" || { cat "$work/help.out" >&2; fail "--help printed no usage"; }
+
 # A DDS domain of our own (the lock is released when this shell exits).
 domain=""
 for i in $(seq 0 98); do
