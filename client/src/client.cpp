@@ -498,10 +498,12 @@ void SharedParticipant::create(const std::string& participant_profile, const std
   }
   const bool secure = !security_dir.empty();
   if (secure) {
+    // A credential missing from the directory is a bad option (the caller's to fix), not a DDS
+    // failure: std::invalid_argument, as for a bad domain id (the CLI's exit status 2, not 3).
     try {
       idl::add_security_properties(security_dir, participant_qos);
     } catch (const std::invalid_argument& e) {
-      throw ClientError(std::string("security_dir: ") + e.what());
+      throw std::invalid_argument(std::string("ClientOptions.security_dir: ") + e.what());
     }
   }
   participant_ = factory->create_participant(static_cast<dds::DomainId_t>(domain_id_), participant_qos);

@@ -152,5 +152,24 @@ TEST(RequestCli, NamesThePlannerKeysItDoesNotSend) {
   EXPECT_EQ(carried.find("not sent"), std::string::npos) << carried;
 }
 
+// A credentials directory that lacks a file is a bad argument (exit status 2, the file named),
+// not a DDS failure (it was status 3, "DDS setup failed").
+TEST(RequestCli, ASecurityDirWithoutItsCredentialsIsABadArgument) {
+  DomainLease lease;
+  TempDir temp;
+  const std::string err_file = temp.path() + "/request.err";
+  ChildProcess request(
+      {PULLOUT_CLI_EXE, "request", source_path("tests/scenarios/straight_shoulder.yaml"), "--security-dir", temp.path(),
+       "--domain", std::to_string(lease.domain()), "--profiles", loopback_profiles_path(), "--timeout", "0.5"},
+      temp.path() + "/request.out", err_file);
+  const auto exit = request.wait_exit(15s);
+  ASSERT_TRUE(exit && exit->exited);
+  EXPECT_EQ(exit->exit_code, 2);
+  const std::string err = read_file_tail(err_file, 4000);
+  EXPECT_NE(err.find("ClientOptions.security_dir: DDS security credentials: " + temp.path() + "/ca.pem is missing"),
+            std::string::npos)
+      << err;
+}
+
 }  // namespace
 }  // namespace pullout::integration

@@ -210,8 +210,9 @@ class PULLOUT_CLIENT_EXPORT Client {
   using Duration = std::chrono::nanoseconds;
 
   // Creates the participant, topics, readers and writers. Does not wait for the service (see
-  // wait_for_service). Throws std::invalid_argument for a bad vehicle_id or domain_id, and
-  // ClientError when DDS cannot be set up (the message names what failed).
+  // wait_for_service). Throws std::invalid_argument for a bad vehicle_id or domain_id or a
+  // security_dir that lacks a credential, and ClientError when DDS cannot be set up (the message
+  // names what failed).
   explicit Client(ClientOptions options);
   // A client on a shared participant (see "Many vehicles on one participant" above): creates this
   // vehicle's readers and writers on it. Throws as above, and std::invalid_argument when the
