@@ -351,7 +351,6 @@ class __attribute__((visibility("hidden"))) Client::Impl final : public client_d
  private:
   void create_entities();
   void destroy_entities() noexcept;
-  void unregister_own_instances() noexcept;
   dds::DataWriterQos writer_qos(const char* profile) const;
   dds::DataReaderQos reader_qos(const char* profile, int depth) const;
   dds::DataReader* create_reply_reader(dds::Topic* topic, const char* profile, int depth,
@@ -684,9 +683,8 @@ void Hub::remove(const std::string& vehicle_id, bool wrote_request, bool wrote_p
     last_change_ = SteadyClock::now();
   }
   wake_.set_trigger_value(true);
-  // As a Client with endpoints of its own does before deleting them: the service sees the
-  // vehicle's instances go (with the writers' default autodispose_unregistered_instances,
-  // disposed) and may evict it.
+  // As a Client's own writers being deleted: the service sees the vehicle's instances go (with
+  // the writers' default autodispose_unregistered_instances, disposed) and may evict it.
   if (wrote_request) {
     msg::PullOutRequest key;
     key.vehicle_id(vehicle_id);
@@ -996,39 +994,11 @@ dds::DataReaderQos Client::Impl::reader_qos(const char* profile, int depth) cons
   return qos;
 }
 
-// Endpoints of its own: the vehicle's request and progress instances are unregistered before the
-// writers go, and the unregister acknowledged (bounded, kUnregisterAckWait per writer). Fast DDS
-// 2.9.1 gives a reader no sample when a deleted writer's instances lose their writer (fixed
-// upstream in 2.14 / 3.x, eProsima/Fast-DDS#5943), so without this the service never saw such a
-// vehicle go and kept its session until session_idle_timeout_s (300 s): every `pullout request`.
-void Client::Impl::unregister_own_instances() noexcept {
-  constexpr std::uint32_t kUnregisterAckWaitNs = 250'000'000;
-  const eprosima::fastrtps::Duration_t ack_wait(0, kUnregisterAckWaitNs);
-  try {
-    if (wrote_request_.load() && ep_.request_writer != nullptr) {
-      msg::PullOutRequest key;
-      key.vehicle_id(options_.vehicle_id);
-      ep_.request_writer->unregister_instance(&key, dds::HANDLE_NIL);
-      ep_.request_writer->wait_for_acknowledgments(ack_wait);
-    }
-    if (wrote_progress_.load() && ep_.progress_writer != nullptr) {
-      msg::ExecutionProgress key;
-      key.vehicle_id(options_.vehicle_id);
-      ep_.progress_writer->unregister_instance(&key, dds::HANDLE_NIL);
-      ep_.progress_writer->wait_for_acknowledgments(ack_wait);
-    }
-  } catch (...) {
-    // Best effort: the service still evicts the vehicle after its idle timeout.
-  }
-}
-
 void Client::Impl::destroy_entities() noexcept {
   if (!shared_) return;
   if (hub_ != nullptr) {
     hub_->remove(options_.vehicle_id, wrote_request_.load(), wrote_progress_.load());
     hub_ = nullptr;
-  } else {
-    unregister_own_instances();
   }
   {
     // Only this client's entities: the other clients on the participant keep theirs. Readers
@@ -1201,8 +1171,8 @@ void Client::Impl::report_progress(ExecutionProgress progress) {
 }
 
 bool Client::Impl::write_request(msg::PullOutRequest* sample) {
-  wrote_request_.store(true);  // before the write: a destroyed client unregisters the instance
   if (hub_ == nullptr) return ep_.request_writer->write(sample);
+  wrote_request_.store(true);  // before the write: a destroyed client unregisters the instance
   return hub_->write_request(sample);
 }
 

@@ -53,9 +53,7 @@
 // dropped by the type support (they never reach a callback nor a wait).
 //
 // Lifetime: the destructor stops the client's thread (waiting for a running callback to return),
-// unregisters the vehicle's request and progress instances it wrote (waiting up to 0.25 s per
-// writer for the service to acknowledge: the service then evicts the vehicle's idle session at
-// once), then deletes every DDS entity. Do not destroy a Client from one of its callbacks, nor while
+// then deletes every DDS entity. Do not destroy a Client from one of its callbacks, nor while
 // another thread is inside one of its member functions.
 //
 // Many vehicles on one participant (a vehicle gateway, a fleet simulator). A ClientParticipant owns
@@ -85,7 +83,7 @@
 //     service (the two readers' new set reaches the service's two writers one after the other),
 //     and the re-send has the service publish both again;
 //   - destroying a Client unregisters its request and progress instances (the service sees the
-//     vehicle go, as a Client with endpoints of its own unregisters them before deleting them);
+//     vehicle go, as when a Client's own writers are deleted);
 //   - the set holds at most about 25 KB of ids (pullout/idl/vehicle_filter.hpp: about 2,300 ids
 //     of 8 bytes); a Client for which it has no room gets endpoints of its own, as below.
 // With shared_endpoints false, each Client has its own request and progress writers and its own
