@@ -1,5 +1,6 @@
 #include "config/grid_file.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -22,6 +23,7 @@ namespace {
 // max_grid_cells, 16 Mi, at most 256 MiB of text).
 constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
 constexpr std::size_t kMaxP2BytesPerPixel = 16;
+constexpr std::size_t kMaxMapYamlBytes = 64 * 1024;  // a map_server YAML file (image, resolution, origin, ...)
 constexpr double kDrawBudgetMs = 2000.0;  // [ms] drawing a scenario grid's obstacles (see read_scenario_grid)
 
 bool resolution_ok(double resolution) {
@@ -184,13 +186,28 @@ bool load_map_server_grid(const std::string& yaml_file, const std::string& key_p
     problems.push_back(key_path + ": " + yaml_file + ": cannot read file (not a regular file)");
     return false;
   }
+  // Read here, at most kMaxMapYamlBytes (a map_server file is a few lines): a read error inside
+  // yaml-cpp's own stream (EIO, /proc/self/mem) leaked its buffer (LeakSanitizer).
+  std::string text;
   try {
-    doc = YAML::LoadFile(yaml_file);
+    std::ifstream in(yaml_file, std::ios::binary);
+    text.assign(kMaxMapYamlBytes + 1, '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+    if (in.bad()) throw std::ios_base::failure("read error");
+  } catch (const std::exception& e) {
+    problems.push_back(key_path + ": " + yaml_file + ": cannot read file (" + e.what() + ")");
+    return false;
+  }
+  if (text.size() > kMaxMapYamlBytes) {
+    problems.push_back(key_path + ": " + yaml_file + ": larger than " + std::to_string(kMaxMapYamlBytes) +
+                       " bytes: not a map_server file");
+    return false;
+  }
+  try {
+    doc = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     problems.push_back(key_path + ": " + yaml_file + ": " + e.what());
-    return false;
-  } catch (const std::exception& e) {  // a read error (EIO, /proc/self/mem): std::ios_failure
-    problems.push_back(key_path + ": " + yaml_file + ": cannot read file (" + e.what() + ")");
     return false;
   }
   const std::size_t before = problems.size();
@@ -351,7 +368,8 @@ bool read_scenario_grid(yaml_fields::MapReader& parent, const std::string& base_
   if (!(cells_x >= 1.0 && cells_y >= 1.0 && cells_x * cells_y <= static_cast<double>(limits.max_grid_cells))) {
     std::ostringstream os;
     os << "grid.size: must give 1 to " << cell_limit(limits.max_grid_cells) << ", got " << cells_x << " x " << cells_y;
-    if (cells_x * cells_y < 1e15) os << " = " << static_cast<long long>(cells_x * cells_y);
+    const double cells = cells_x * cells_y;  // (NaN, negative or huge for a bad size: no product then)
+    if (cells >= 0.0 && cells < 1e15) os << " = " << static_cast<long long>(cells);
     problems.push_back(os.str());
     return false;
   }
