@@ -181,7 +181,7 @@ double sharpest_turn(const PullOutPath& path) {
 // drive. The candidates behind are skipped then, saying why; a vehicle 10 degrees off keeps them.
 TEST(StartPlanner, AVehicleAcrossItsLaneGetsNoReverseItCannotDrive) {
   const VehicleInfo vehicle;
-  const double full_steer_curvature = std::tan(vehicle.max_steer_angle_rad) / vehicle.wheel_base_m;
+  const double full_steer_curvature = 1.0 / vehicle.min_turning_radius_m();
   for (const double yaw_deg : {-80.0, -45.0, 90.0}) {
     auto req = test::straight_shoulder_request();
     req.ego_pose.yaw = yaw_deg * kDegToRad;

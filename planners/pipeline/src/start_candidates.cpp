@@ -60,8 +60,7 @@ StartCandidateSearch search_start_candidates(const PlanningContext& ctx, const S
   // within a metre). Beyond that, no candidate behind it.
   const double lane_yaw = lanes.centerline.yaw_at(at.s) + (at.facing > 0.0 ? 0.0 : kPi);
   const double deviation = normalize_angle(ego.yaw - lane_yaw);
-  const double full_steer_radius = ctx.vehicle.wheel_base_m / std::tan(ctx.vehicle.max_steer_angle_rad);
-  const double turnable = p.center_line_path_interval / full_steer_radius;  // [rad] in the first step
+  const double turnable = p.center_line_path_interval / ctx.vehicle.min_turning_radius_m();  // [rad], first step
   if (allowed > kMinCandidateSpacing && std::abs(deviation) > turnable) {
     out.skipped.push_back({std::min(p.backward_search_resolution, allowed),
                            what + "s behind skipped: the vehicle's heading deviates " +

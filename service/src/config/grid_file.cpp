@@ -191,9 +191,7 @@ bool load_map_server_grid(const std::string& yaml_file, const std::string& key_p
   std::string text;
   try {
     std::ifstream in(yaml_file, std::ios::binary);
-    text.assign(kMaxMapYamlBytes + 1, '\0');
-    in.read(text.data(), static_cast<std::streamsize>(text.size()));
-    text.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+    text = read_at(in, 0, kMaxMapYamlBytes + 1);
     if (in.bad()) throw std::ios_base::failure("read error");
   } catch (const std::exception& e) {
     problems.push_back(key_path + ": " + yaml_file + ": cannot read file (" + e.what() + ")");

@@ -11,6 +11,8 @@
 #include <memory>
 #include <mutex>
 
+#include "pullout/geometry/polygon.hpp"
+
 namespace pullout {
 
 namespace {
@@ -23,11 +25,16 @@ double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
   return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
 }
 
-// Andrew's monotone chain; counter-clockwise, no collinear points.
-Polygon convex_hull(Polygon pts) {
+// The points sorted by x, then y, each once.
+Polygon distinct_points(Polygon pts) {
   std::sort(pts.begin(), pts.end(),
             [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  return pts;
+}
+
+// Andrew's monotone chain over distinct_points; counter-clockwise, no collinear points.
+Polygon convex_hull(const Polygon& pts) {
   if (pts.size() < 3) return pts;
   Polygon hull(2 * pts.size());
   std::size_t k = 0;
@@ -43,28 +50,6 @@ Polygon convex_hull(Polygon pts) {
   return hull;
 }
 
-double signed_area(const Polygon& pts) {
-  double a = 0.0;
-  for (std::size_t i = 0, j = pts.size() - 1; i < pts.size(); j = i++) {
-    a += pts[j].x() * pts[i].y() - pts[i].x() * pts[j].y();
-  }
-  return 0.5 * a;
-}
-
-// Whether segments ab and cd share a point.
-bool segments_meet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
-  const double d1 = cross(c, d, a);
-  const double d2 = cross(c, d, b);
-  const double d3 = cross(a, b, c);
-  const double d4 = cross(a, b, d);
-  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
-  const auto on = [](const Vec2& p, const Vec2& q, const Vec2& r) {  // r on segment pq, given collinear
-    return std::min(p.x(), q.x()) <= r.x() && r.x() <= std::max(p.x(), q.x()) && std::min(p.y(), q.y()) <= r.y() &&
-           r.y() <= std::max(p.y(), q.y());
-  };
-  return (d1 == 0 && on(c, d, a)) || (d2 == 0 && on(c, d, b)) || (d3 == 0 && on(a, b, c)) || (d4 == 0 && on(a, b, d));
-}
-
 // Whether the closed polygon (no repeated consecutive points, no collinear ones) is simple: no
 // two edges meet except neighbours at their common vertex.
 bool simple(const Polygon& pts) {
@@ -72,7 +57,7 @@ bool simple(const Polygon& pts) {
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i + 2; j < n; ++j) {
       if (i == 0 && j == n - 1) continue;  // neighbours through the closing edge
-      if (segments_meet(pts[i], pts[(i + 1) % n], pts[j], pts[(j + 1) % n])) return false;
+      if (segments_intersect(pts[i], pts[(i + 1) % n], pts[j], pts[(j + 1) % n])) return false;
     }
   }
   return true;
@@ -209,14 +194,11 @@ ObjectChecker::ObjectChecker(const Footprint& vehicle, std::vector<Obstacle> obs
   impl_->box_radius = 0.5 * std::hypot(vehicle.length(), vehicle.width());
   impl_->box = std::make_shared<fcl::Boxd>(vehicle.length(), vehicle.width(), kPrismHeight);
   for (Obstacle& o : obstacles) {
-    const Polygon hull = convex_hull(o.polygon);
+    const Polygon distinct = distinct_points(o.polygon);
+    const Polygon hull = convex_hull(distinct);
     if (hull.size() < 3) continue;  // degenerate: validation rejects such objects earlier
     PreparedObstacle prepared{o.id, prism_piece(hull), nullptr};
     // Convex (its hull has all of its distinct points): the hull is the object.
-    Polygon distinct = o.polygon;
-    std::sort(distinct.begin(), distinct.end(),
-              [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
     if (distinct.size() != hull.size()) {
       prepared.pieces = std::make_unique<LazyPieces>();
       prepared.pieces->polygon = std::move(o.polygon);
